@@ -1,0 +1,26 @@
+// Scene importers. Each reads one file and returns a Scene in world space (DESIGN.md "Scene model").
+// All throw InputError with the file name and the place (line, node, accessor) on malformed input.
+#pragma once
+
+#include <string>
+
+#include "vox/scene.h"
+
+namespace vox {
+
+// Dispatches on the extension: .txt (course format), .obj, .gltf/.glb, .ply.
+Scene loadScene(const std::string& path);
+
+// The MIT 6.837 text scene format (grammar in seed-scenes/6837/README.md). TriangleMesh paths are resolved relative
+// to the scene file's folder. Procedural materials (Checkerboard, Noise, Marble, Wood) become their first
+// material's colour, with a warning.
+Scene importCourseScene(const std::string& path);
+// Wavefront OBJ through tinyobjloader: polygons triangulated, .mtl Kd as diffuse colour.
+Scene importObj(const std::string& path);
+// glTF 2.0 (.gltf, .glb) through tinygltf: node hierarchy (matrix or TRS), triangle primitives (indexed or not),
+// baseColorFactor, cameras, KHR_lights_punctual. Other primitive modes are skipped with a warning.
+Scene importGltf(const std::string& path);
+// PLY triangle meshes through OpenMesh.
+Scene importPly(const std::string& path);
+
+}  // namespace vox

@@ -1,0 +1,24 @@
+// Primitive-cell overlap tests, one per method (DESIGN.md "Overlap methods"). Boxes are closed.
+// Triangles and spheres are surfaces: a sphere meets a box when the box is neither entirely outside the ball
+// nor strictly inside it.
+#pragma once
+
+#include "vox/math.h"
+#include "vox/scene.h"
+
+namespace vox {
+
+// exact: CGAL exact predicates; no epsilon; correct for any finite double input, degenerate triangles included.
+bool triangleBoxExact(const Triangle& t, const Box& box);
+bool sphereBoxExact(const Sphere& s, const Box& box);
+
+// sat: Akenine-Moller 2001 separating-axis test in double precision, and a floating-point sphere-box distance test.
+bool triangleBoxSat(const Triangle& t, const Box& box);
+bool sphereBoxSat(const Sphere& s, const Box& box);
+
+// Filtered exact triangle test: a double-precision separating-axis test with a conservative error bound decides
+// almost every case; it calls triangleBoxExact only when the bound cannot. `usedFallback` reports which.
+bool triangleBoxFiltered(const Triangle& t, const Box& box, bool* usedFallback = nullptr);
+bool sphereBoxFiltered(const Sphere& s, const Box& box, bool* usedFallback = nullptr);
+
+}  // namespace vox

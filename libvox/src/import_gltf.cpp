@@ -1,0 +1,410 @@
+// glTF 2.0 (.gltf, .glb) through tinygltf (Debian's 2.7.0, which includes <nlohmann/json.hpp> itself and
+// stb_image.h by its plain name: /usr/include/stb is on the include path). This is the one translation unit that
+// holds the tinygltf and stb implementations.
+//
+// Quirks relied on:
+// - tinygltf 2.7 checks buffer sizes against byteLength but not accessor or bufferView ranges, nor node, mesh,
+//   material or camera indices: everything used here is range-checked before it is read.
+// - it does not enforce `extensionsRequired`, so KHR_materials_sheen or KHR_texture_transform listed as required
+//   do not stop loading; we only want geometry from them.
+// - node lights (KHR_lights_punctual) are not parsed into Node; we read node.extensions ourselves.
+// - image decoding is replaced by a no-op: textures are not used (base colour comes from the factor), and
+//   untrusted PNG/JPEG bytes then never reach stb_image.
+#define TINYGLTF_IMPLEMENTATION
+#define STB_IMAGE_IMPLEMENTATION
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "vox/error.h"
+#include "vox/import.h"
+
+namespace vox {
+namespace {
+
+bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+  return true;
+}
+
+std::string trimmed(std::string s) {
+  while (!s.empty() && (s.back() == '\n' || s.back() == '\r' || s.back() == ' ')) s.pop_back();
+  return s;
+}
+
+size_t componentSize(int componentType) {
+  switch (componentType) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+      return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+      return 2;
+    case TINYGLTF_COMPONENT_TYPE_INT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+    case TINYGLTF_COMPONENT_TYPE_FLOAT:
+      return 4;
+    default:
+      return 0;
+  }
+}
+
+// Column-major glTF 4x4 (as in node.matrix) to our row-major Mat4.
+Mat4 fromColumnMajor(const std::vector<double>& c) {
+  Mat4 out;
+  for (int r = 0; r < 4; ++r)
+    for (int k = 0; k < 4; ++k) out.m[r][k] = c[static_cast<size_t>(k * 4 + r)];
+  return out;
+}
+
+// Unit quaternion (x, y, z, w) to a rotation matrix.
+Mat4 fromQuaternion(double x, double y, double z, double w) {
+  const double len = std::sqrt(x * x + y * y + z * z + w * w);
+  if (len > 0) {
+    x /= len;
+    y /= len;
+    z /= len;
+    w /= len;
+  }
+  Mat4 r;
+  r.m[0] = {1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w), 0};
+  r.m[1] = {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w), 0};
+  r.m[2] = {2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y), 0};
+  return r;
+}
+
+class GltfReader {
+ public:
+  GltfReader(std::string path, const tinygltf::Model& model) : path_(std::move(path)), model_(model) {}
+
+  Scene read() {
+    readMaterials();
+    std::vector<int> roots;
+    if (!model_.scenes.empty()) {
+      int sceneIndex = model_.defaultScene;
+      if (sceneIndex < 0 || static_cast<size_t>(sceneIndex) >= model_.scenes.size()) sceneIndex = 0;
+      roots = model_.scenes[static_cast<size_t>(sceneIndex)].nodes;
+    } else {
+      // No scenes: every node that is nobody's child is a root.
+      std::vector<bool> isChild(model_.nodes.size(), false);
+      for (const auto& node : model_.nodes)
+        for (int c : node.children)
+          if (c >= 0 && static_cast<size_t>(c) < isChild.size()) isChild[static_cast<size_t>(c)] = true;
+      for (size_t i = 0; i < isChild.size(); ++i)
+        if (!isChild[i]) roots.push_back(static_cast<int>(i));
+    }
+    std::vector<bool> onPath(model_.nodes.size(), false);
+    for (int root : roots) visitNode(root, Mat4::identity(), onPath, 0);
+
+    if (usesDefaultMaterial_ || scene_.materials.empty()) {
+      // Index defaultMaterial_ == model_.materials.size(), reserved in readMaterials.
+      scene_.materials.push_back(Material{"default"});
+    }
+    return std::move(scene_);
+  }
+
+ private:
+  template <typename... Parts>
+  [[noreturn]] void failHere(const Parts&... parts) const {
+    fail<InputError>(path_, ": ", parts...);
+  }
+
+  template <typename... Parts>
+  void warn(const Parts&... parts) {
+    std::ostringstream out;
+    out << path_ << ": ";
+    (out << ... << parts);
+    scene_.warnings.push_back(out.str());
+  }
+
+  void readMaterials() {
+    bool textured = false;
+    for (const auto& m : model_.materials) {
+      Material out;
+      out.name = m.name;
+      const auto& f = m.pbrMetallicRoughness.baseColorFactor;
+      if (f.size() >= 3) out.diffuse = {f[0], f[1], f[2]};
+      if (m.pbrMetallicRoughness.baseColorTexture.index >= 0) textured = true;
+      scene_.materials.push_back(out);
+    }
+    defaultMaterial_ = static_cast<uint32_t>(scene_.materials.size());
+    if (textured) warn("base colour textures are used as their baseColorFactor only");
+  }
+
+  void visitNode(int index, const Mat4& parent, std::vector<bool>& onPath, int depth) {
+    if (index < 0 || static_cast<size_t>(index) >= model_.nodes.size())
+      failHere("node ", index, " does not exist (", model_.nodes.size(), " nodes)");
+    const size_t i = static_cast<size_t>(index);
+    if (onPath[i]) failHere("node ", index, ": cycle in the node hierarchy");
+    constexpr int kMaxDepth = 1000;
+    if (depth > kMaxDepth) failHere("node ", index, ": hierarchy deeper than ", kMaxDepth);
+    const tinygltf::Node& node = model_.nodes[i];
+
+    Mat4 local;
+    if (node.matrix.size() == 16) {
+      local = fromColumnMajor(node.matrix);
+    } else {
+      if (!node.matrix.empty()) failHere("node ", index, ": matrix has ", node.matrix.size(), " numbers, not 16");
+      Mat4 t, r, s;
+      if (node.translation.size() == 3) t = translation({node.translation[0], node.translation[1], node.translation[2]});
+      else if (!node.translation.empty()) failHere("node ", index, ": translation needs 3 numbers");
+      if (node.rotation.size() == 4)
+        r = fromQuaternion(node.rotation[0], node.rotation[1], node.rotation[2], node.rotation[3]);
+      else if (!node.rotation.empty()) failHere("node ", index, ": rotation needs 4 numbers");
+      if (node.scale.size() == 3) s = scaling({node.scale[0], node.scale[1], node.scale[2]});
+      else if (!node.scale.empty()) failHere("node ", index, ": scale needs 3 numbers");
+      local = t * r * s;  // glTF: T * R * S
+    }
+    const Mat4 world = parent * local;
+
+    if (node.camera >= 0 && !scene_.camera) readCamera(index, node.camera, world);
+    readLight(index, node, world);
+    if (node.mesh >= 0) readMesh(index, node.mesh, world);
+
+    onPath[i] = true;
+    for (int child : node.children) visitNode(child, world, onPath, depth + 1);
+    onPath[i] = false;
+  }
+
+  void readCamera(int nodeIndex, int cameraIndex, const Mat4& world) {
+    if (static_cast<size_t>(cameraIndex) >= model_.cameras.size())
+      failHere("node ", nodeIndex, ": camera ", cameraIndex, " does not exist");
+    const tinygltf::Camera& c = model_.cameras[static_cast<size_t>(cameraIndex)];
+    Camera cam;
+    if (c.type == "perspective") {
+      cam.kind = CameraKind::Perspective;
+      cam.fovDegrees = c.perspective.yfov * 180.0 / M_PI;
+      if (!(cam.fovDegrees > 0 && cam.fovDegrees < 180))
+        failHere("camera ", cameraIndex, ": yfov ", c.perspective.yfov, " is not in (0, pi)");
+    } else if (c.type == "orthographic") {
+      cam.kind = CameraKind::Orthographic;
+      cam.orthoHeight = 2 * std::fabs(c.orthographic.ymag);
+      if (!(cam.orthoHeight > 0)) failHere("camera ", cameraIndex, ": ymag must not be zero");
+    } else {
+      failHere("camera ", cameraIndex, ": unknown type '", c.type, "'");
+    }
+    // glTF cameras look down their local -Z with +Y up.
+    cam.center = transformPoint(world, {0, 0, 0});
+    cam.direction = normalize(transformVector(world, {0, 0, -1}));
+    cam.up = normalize(transformVector(world, {0, 1, 0}));
+    if (length(cam.direction) == 0 || length(cam.up) == 0) failHere("node ", nodeIndex, ": camera under a singular transform");
+    scene_.camera = cam;
+  }
+
+  void readLight(int nodeIndex, const tinygltf::Node& node, const Mat4& world) {
+    const auto ext = node.extensions.find("KHR_lights_punctual");
+    if (ext == node.extensions.end() || !ext->second.IsObject() || !ext->second.Has("light")) return;
+    const tinygltf::Value& v = ext->second.Get("light");
+    if (!v.IsNumber()) failHere("node ", nodeIndex, ": KHR_lights_punctual light is not a number");
+    const int lightIndex = v.GetNumberAsInt();
+    if (lightIndex < 0 || static_cast<size_t>(lightIndex) >= model_.lights.size())
+      failHere("node ", nodeIndex, ": light ", lightIndex, " does not exist (", model_.lights.size(), " lights)");
+    const tinygltf::Light& l = model_.lights[static_cast<size_t>(lightIndex)];
+    Light out;
+    Vec3 color{1, 1, 1};
+    if (l.color.size() >= 3) color = {l.color[0], l.color[1], l.color[2]};
+    // Physical intensities (lux, candela) mean nothing to a Phong shader without exposure: see import.h.
+    out.color = color * std::min(l.intensity, 1.0);
+    if (l.type == "directional") {
+      out.kind = LightKind::Directional;
+      out.direction = normalize(transformVector(world, {0, 0, -1}));
+    } else if (l.type == "point" || l.type == "spot") {
+      out.kind = LightKind::Point;
+      out.position = transformPoint(world, {0, 0, 0});
+      out.attenuation = {1, 0, 0};
+      if (l.type == "spot") warn("light ", lightIndex, " (node ", nodeIndex, "): spot light imported as a point light");
+    } else {
+      warn("light ", lightIndex, ": unknown type '", l.type, "' skipped");
+      return;
+    }
+    scene_.lights.push_back(out);
+  }
+
+  // A validated view of an accessor's elements: element i starts at base + i * stride.
+  struct View {
+    const unsigned char* base = nullptr;
+    size_t stride = 0;
+    size_t count = 0;
+  };
+
+  View accessorView(int accessorIndex, size_t elementSize) {
+    if (accessorIndex < 0 || static_cast<size_t>(accessorIndex) >= model_.accessors.size())
+      failHere("accessor ", accessorIndex, " does not exist (", model_.accessors.size(), " accessors)");
+    const tinygltf::Accessor& a = model_.accessors[static_cast<size_t>(accessorIndex)];
+    if (a.sparse.isSparse) failHere("accessor ", accessorIndex, ": sparse accessors are not supported");
+    if (a.bufferView < 0 || static_cast<size_t>(a.bufferView) >= model_.bufferViews.size())
+      failHere("accessor ", accessorIndex, ": bufferView ", a.bufferView, " does not exist");
+    const tinygltf::BufferView& bv = model_.bufferViews[static_cast<size_t>(a.bufferView)];
+    if (bv.buffer < 0 || static_cast<size_t>(bv.buffer) >= model_.buffers.size())
+      failHere("accessor ", accessorIndex, ": bufferView ", a.bufferView, ": buffer ", bv.buffer, " does not exist");
+    const std::vector<unsigned char>& data = model_.buffers[static_cast<size_t>(bv.buffer)].data;
+    // All in unsigned 64-bit with explicit overflow guards: the numbers come from an untrusted file.
+    const uint64_t size = data.size();
+    if (bv.byteOffset > size || bv.byteLength > size - bv.byteOffset)
+      failHere("accessor ", accessorIndex, ": bufferView ", a.bufferView, " (offset ", bv.byteOffset, ", length ",
+               bv.byteLength, ") exceeds buffer ", bv.buffer, " (", size, " bytes)");
+    const size_t stride = bv.byteStride ? bv.byteStride : elementSize;
+    if (stride < elementSize)
+      failHere("accessor ", accessorIndex, ": byteStride ", stride, " is smaller than an element (", elementSize,
+               " bytes)");
+    View view{nullptr, stride, a.count};
+    if (a.count == 0) return view;
+    const uint64_t limit = std::numeric_limits<uint64_t>::max() / 2;
+    if (a.count > limit / stride)
+      failHere("accessor ", accessorIndex, ": count ", a.count, " is too large");
+    const uint64_t span = uint64_t(a.count - 1) * stride + elementSize;
+    if (a.byteOffset > bv.byteLength || span > bv.byteLength - a.byteOffset)
+      failHere("accessor ", accessorIndex, ": offset ", a.byteOffset, " + ", a.count, " elements of stride ", stride,
+               " exceeds bufferView ", a.bufferView, " (", bv.byteLength, " bytes)");
+    view.base = data.data() + bv.byteOffset + a.byteOffset;
+    return view;
+  }
+
+  std::vector<Vec3> readPositions(int accessorIndex) {
+    if (accessorIndex < 0 || static_cast<size_t>(accessorIndex) >= model_.accessors.size())
+      failHere("accessor ", accessorIndex, " does not exist (", model_.accessors.size(), " accessors)");
+    const tinygltf::Accessor& a = model_.accessors[static_cast<size_t>(accessorIndex)];
+    if (a.type != TINYGLTF_TYPE_VEC3 || a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT)
+      failHere("accessor ", accessorIndex, ": POSITION must be float VEC3 (quantized positions are not supported)");
+    const View view = accessorView(accessorIndex, 12);
+    std::vector<Vec3> out(view.count);
+    for (size_t i = 0; i < view.count; ++i) {
+      float xyz[3];
+      std::memcpy(xyz, view.base + i * view.stride, sizeof xyz);
+      out[i] = {xyz[0], xyz[1], xyz[2]};
+    }
+    return out;
+  }
+
+  std::vector<uint32_t> readIndices(int accessorIndex, size_t vertexCount) {
+    const tinygltf::Accessor& a = model_.accessors.at(static_cast<size_t>(accessorIndex));
+    if (a.type != TINYGLTF_TYPE_SCALAR) failHere("accessor ", accessorIndex, ": indices must be SCALAR");
+    const int ct = a.componentType;
+    if (ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+      failHere("accessor ", accessorIndex, ": indices must be UNSIGNED_BYTE, UNSIGNED_SHORT or UNSIGNED_INT");
+    const size_t size = componentSize(ct);
+    const View view = accessorView(accessorIndex, size);
+    std::vector<uint32_t> out(view.count);
+    for (size_t i = 0; i < view.count; ++i) {
+      const unsigned char* p = view.base + i * view.stride;
+      uint32_t value = 0;
+      if (size == 1) {
+        value = p[0];
+      } else if (size == 2) {
+        uint16_t v16;
+        std::memcpy(&v16, p, 2);
+        value = v16;
+      } else {
+        std::memcpy(&value, p, 4);
+      }
+      if (value >= vertexCount)
+        failHere("accessor ", accessorIndex, ": index ", value, " at element ", i, " out of range (", vertexCount,
+                 " vertices)");
+      out[i] = value;
+    }
+    return out;
+  }
+
+  void readMesh(int nodeIndex, int meshIndex, const Mat4& world) {
+    if (static_cast<size_t>(meshIndex) >= model_.meshes.size())
+      failHere("node ", nodeIndex, ": mesh ", meshIndex, " does not exist (", model_.meshes.size(), " meshes)");
+    const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(meshIndex)];
+    bool warnedMode = false;
+    for (size_t p = 0; p < mesh.primitives.size(); ++p) {
+      const tinygltf::Primitive& prim = mesh.primitives[p];
+      const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+      if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+          mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+        if (!warnedMode)
+          warn("mesh ", meshIndex, " '", mesh.name, "': primitives of mode ", mode,
+               " (points or lines) skipped: they are not surfaces");
+        warnedMode = true;
+        continue;
+      }
+      const auto pos = prim.attributes.find("POSITION");
+      if (pos == prim.attributes.end()) {
+        warn("mesh ", meshIndex, " '", mesh.name, "' primitive ", p, ": no POSITION, skipped");
+        continue;
+      }
+      std::vector<Vec3> vertices = readPositions(pos->second);
+      for (Vec3& v : vertices) v = transformPoint(world, v);
+      std::vector<uint32_t> index;
+      if (prim.indices >= 0) {
+        if (static_cast<size_t>(prim.indices) >= model_.accessors.size())
+          failHere("mesh ", meshIndex, " primitive ", p, ": indices accessor ", prim.indices, " does not exist");
+        index = readIndices(prim.indices, vertices.size());
+      } else {
+        index.resize(vertices.size());
+        for (size_t i = 0; i < index.size(); ++i) index[i] = static_cast<uint32_t>(i);
+      }
+      uint32_t material = defaultMaterial_;
+      if (prim.material >= 0 && static_cast<size_t>(prim.material) < model_.materials.size())
+        material = static_cast<uint32_t>(prim.material);
+      else if (prim.material >= 0)
+        failHere("mesh ", meshIndex, " primitive ", p, ": material ", prim.material, " does not exist");
+      else
+        usesDefaultMaterial_ = true;
+
+      auto emit = [&](uint32_t a, uint32_t b, uint32_t c) {
+        scene_.triangles.push_back({{vertices[a], vertices[b], vertices[c]}, material});
+      };
+      if (mode == TINYGLTF_MODE_TRIANGLES) {
+        if (index.size() % 3 != 0)
+          warn("mesh ", meshIndex, " primitive ", p, ": ", index.size(), " indices is not a multiple of 3; ",
+               index.size() % 3, " ignored");
+        for (size_t i = 0; i + 2 < index.size(); i += 3) emit(index[i], index[i + 1], index[i + 2]);
+      } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+        // Every other triangle is flipped to keep the strip's winding (glTF spec 3.7.2.1).
+        for (size_t i = 0; i + 2 < index.size(); ++i)
+          if (i % 2 == 0)
+            emit(index[i], index[i + 1], index[i + 2]);
+          else
+            emit(index[i + 1], index[i], index[i + 2]);
+      } else {
+        for (size_t i = 1; i + 1 < index.size(); ++i) emit(index[0], index[i], index[i + 1]);
+      }
+    }
+  }
+
+  std::string path_;
+  const tinygltf::Model& model_;
+  Scene scene_;
+  uint32_t defaultMaterial_ = 0;
+  bool usesDefaultMaterial_ = false;
+};
+
+}  // namespace
+
+Scene importGltf(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail<InputError>(path, ": cannot open glTF file");
+  char magic[4] = {};
+  in.read(magic, 4);
+  const bool binary = in.gcount() == 4 && std::memcmp(magic, "glTF", 4) == 0;
+  in.close();
+
+  tinygltf::TinyGLTF loader;
+  loader.SetImageLoader(skipImage, nullptr);
+  tinygltf::Model model;
+  std::string err, warn;
+  const bool ok = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
+                         : loader.LoadASCIIFromFile(&model, &err, &warn, path);
+  if (!ok) fail<InputError>(path, ": ", err.empty() ? std::string("cannot read glTF file") : trimmed(err));
+
+  Scene scene = GltfReader(path, model).read();
+  std::istringstream lines(warn);
+  std::string line;
+  while (std::getline(lines, line))
+    if (!trimmed(line).empty()) scene.warnings.push_back(path + ": " + trimmed(line));
+  return scene;
+}
+
+}  // namespace vox

@@ -1,0 +1,14 @@
+#include "triangle_filter.h"
+#include "vox/overlap.h"
+
+namespace vox {
+
+bool triangleBoxFiltered(const Triangle& t, const Box& box, bool* usedFallback) {
+  const TriangleFilter filter(t);
+  const FilterResult r = filter.test(box.lo, box.hi, box.lo - filter.origin, box.hi - filter.origin);
+  if (usedFallback) *usedFallback = r == FilterResult::Unknown;
+  if (r == FilterResult::Unknown) return triangleBoxExact(t, box);
+  return r == FilterResult::Overlap;
+}
+
+}  // namespace vox

@@ -1,0 +1,327 @@
+#include "vox/voxelize.h"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <chrono>
+#include <cmath>
+
+#include "radix_sort.h"
+#include "triangle_filter.h"
+#include "vox/error.h"
+#include "vox/overlap.h"
+
+namespace vox {
+
+namespace {
+
+Box paddedBounds(Box b) {
+  const Vec3 extent = b.hi - b.lo;
+  const double largest = std::max({extent.x, extent.y, extent.z});
+  for (int a = 0; a < 3; ++a) {
+    if (b.hi[a] > b.lo[a]) continue;
+    // A flat scene still needs cells across its thin axis: pad by 1% of the largest extent (or 0.5 for a point),
+    // but at least enough ulps that lo < hi holds far from the origin.
+    double pad = largest > 0 ? 0.01 * largest : 0.5;
+    pad = std::max(pad, 4 * std::fabs(b.lo[a]) * DBL_EPSILON + DBL_MIN);
+    b.lo.at(a) -= pad;
+    b.hi.at(a) += pad;
+  }
+  return b;
+}
+
+void checkDims(const std::array<uint32_t, 3>& dims) {
+  for (uint32_t n : dims)
+    if (n == 0 || n > kMaxCellsPerAxis)
+      fail<UsageError>("grid dimension ", n, " out of range (1 to ", kMaxCellsPerAxis, " cells per axis)");
+}
+
+// Cells a primitive may touch, from its bounding box; nullopt when the box misses the grid.
+struct CellRange {
+  std::array<int64_t, 3> first, last;
+  uint64_t count() const {
+    return uint64_t(last[0] - first[0] + 1) * uint64_t(last[1] - first[1] + 1) * uint64_t(last[2] - first[2] + 1);
+  }
+};
+
+std::optional<CellRange> rangeOf(const Grid& grid, const Box& box) {
+  CellRange r;
+  for (int a = 0; a < 3; ++a) {
+    const auto [f, l] = cellRange(grid.bounds, grid.dims, a, box.lo[a], box.hi[a]);
+    if (f > l) return std::nullopt;
+    r.first[a] = f;
+    r.last[a] = l;
+  }
+  return r;
+}
+
+bool inside(const Box& inner, const Box& outer) {
+  for (int a = 0; a < 3; ++a)
+    if (inner.lo[a] < outer.lo[a] || inner.hi[a] > outer.hi[a]) return false;
+  return true;
+}
+
+double triangleArea(const Triangle& t) { return 0.5 * length(cross(t.v[1] - t.v[0], t.v[2] - t.v[0])); }
+
+// A generous estimate of the references a primitive makes: a surface of area A crosses at most about
+// 3 A / h^2 + 2 P / h + 8 cells of side h (h the smallest cell side), and never more than its bounding range.
+double estimateReferences(const Scene& scene, const Grid& grid) {
+  double h = HUGE_VAL;
+  for (int a = 0; a < 3; ++a) h = std::min(h, (grid.bounds.hi[a] - grid.bounds.lo[a]) / grid.dims[a]);
+  double total = 0;
+  auto add = [&](const Box& box, double area, double perimeter) {
+    const auto r = rangeOf(grid, box);
+    if (!r) return;
+    total += std::min(double(r->count()), 3 * area / (h * h) + 2 * perimeter / h + 8);
+  };
+  for (const auto& t : scene.triangles)
+    add(triangleBounds(t), triangleArea(t),
+        length(t.v[1] - t.v[0]) + length(t.v[2] - t.v[1]) + length(t.v[0] - t.v[2]));
+  for (const auto& s : scene.spheres) {
+    const Box b = sphereBounds(s);
+    const Vec3 e = (b.hi - b.lo) * 0.5;
+    add(b, 4 * M_PI * std::max({e.x * e.y, e.y * e.z, e.x * e.z}), 0);
+  }
+  return total;
+}
+
+}  // namespace
+
+std::array<uint32_t, 3> dimsForResolution(const Box& bounds, uint32_t resolution) {
+  if (resolution == 0 || resolution > kMaxCellsPerAxis)
+    fail<UsageError>("resolution ", resolution, " out of range (1 to ", kMaxCellsPerAxis, ")");
+  const Vec3 e = bounds.hi - bounds.lo;
+  const double cell = std::max({e.x, e.y, e.z}) / resolution;
+  std::array<uint32_t, 3> dims;
+  for (int a = 0; a < 3; ++a)
+    dims[a] = uint32_t(std::clamp<double>(std::round(e[a] / cell), 1, resolution));
+  return dims;
+}
+
+std::array<uint32_t, 3> defaultDims(const Box& bounds, size_t boundedPrimitives) {
+  const Vec3 e = bounds.hi - bounds.lo;
+  const double target = std::max(1.0, kCellsPerPrimitive * double(boundedPrimitives));
+  const double cell = std::cbrt(e.x * e.y * e.z / target);
+  std::array<uint32_t, 3> dims;
+  for (int a = 0; a < 3; ++a)
+    dims[a] = uint32_t(std::clamp<double>(std::round(e[a] / cell), 1, 1024));
+  return dims;
+}
+
+Grid planGrid(const Scene& scene, const VoxelizeOptions& options) {
+  Grid grid;
+  grid.method = options.method;
+  if (options.bounds) {
+    const Box& b = *options.bounds;
+    if (!isFinite(b.lo) || !isFinite(b.hi)) fail<UsageError>("bounds must be finite numbers");
+    for (int a = 0; a < 3; ++a)
+      if (!(b.lo[a] < b.hi[a])) fail<UsageError>("bounds: minimum must be below maximum on every axis");
+    grid.bounds = b;
+  } else if (const auto b = sceneBounds(scene)) {
+    grid.bounds = paddedBounds(*b);
+  } else {
+    grid.bounds = {{0, 0, 0}, {1, 1, 1}};
+    grid.dims = {1, 1, 1};
+    return grid;
+  }
+  if (options.dims) {
+    grid.dims = *options.dims;
+  } else if (options.resolution) {
+    grid.dims = dimsForResolution(grid.bounds, *options.resolution);
+  } else {
+    grid.dims = defaultDims(grid.bounds, scene.boundedCount());
+  }
+  checkDims(grid.dims);
+  return grid;
+}
+
+Grid voxelizeScene(const Scene& scene, const VoxelizeOptions& options, VoxelizeStats* stats) {
+  const auto start = std::chrono::steady_clock::now();
+  Grid grid = planGrid(scene, options);
+  const size_t nTri = scene.triangles.size();
+  const size_t nBounded = scene.boundedCount();
+  if (nBounded == 0) return grid;
+  if (nBounded > UINT32_MAX) fail<LimitError>("too many primitives (", nBounded, ")");
+
+  const double estimate = estimateReferences(scene, grid);
+  constexpr double kBytesPerReference = 44;  // packed entry, radix buffer, and the compressed cell lists
+  if (estimate * kBytesPerReference > double(options.memoryLimitBytes))
+    fail<LimitError>("grid ", grid.dims[0], "x", grid.dims[1], "x", grid.dims[2], " needs about ",
+                     uint64_t(estimate * kBytesPerReference / (1 << 20)), " MiB for ", uint64_t(estimate),
+                     " cell references, more than the ", options.memoryLimitBytes >> 20, " MiB allowed");
+
+  std::array<std::vector<double>, 3> boundary;
+  for (int a = 0; a < 3; ++a) {
+    boundary[a].resize(size_t(grid.dims[a]) + 1);
+    for (int64_t i = 0; i <= int64_t(grid.dims[a]); ++i) boundary[a][i] = cellBoundary(grid.bounds, grid.dims, a, i);
+  }
+
+  const int primBits = std::max(1, int(std::bit_width(uint64_t(nBounded - 1))));
+  const int keyBits = int(std::bit_width(grid.cellCount() - 1));
+  const bool packed = primBits + keyBits <= 64;
+  const uint64_t primMask = (uint64_t(1) << primBits) - 1;
+
+  struct Local {
+    std::vector<uint64_t> packedRefs;
+    std::vector<std::pair<uint64_t, uint32_t>> pairRefs;
+    uint64_t tested = 0, fallbacks = 0, degenerate = 0;
+    std::vector<uint32_t> outside;
+  };
+  tbb::enumerable_thread_specific<Local> locals;
+  std::atomic<size_t> done{0};
+  std::atomic<bool> cancelled{false};
+  const std::array<uint32_t, 3> dims = grid.dims;
+
+  auto voxelizePrimitive = [&](size_t id, Local& local) {
+    auto emit = [&](int64_t i, int64_t j, int64_t k) {
+      const uint64_t key = cellKey(dims, i, j, k);
+      if (packed) {
+        local.packedRefs.push_back((key << primBits) | id);
+      } else {
+        local.pairRefs.emplace_back(key, uint32_t(id));
+      }
+    };
+    const bool isTri = id < nTri;
+    const Box primBox = isTri ? triangleBounds(scene.triangles[id]) : sphereBounds(scene.spheres[id - nTri]);
+    if (options.bounds && !inside(primBox, grid.bounds)) local.outside.push_back(uint32_t(id));
+    const auto range = rangeOf(grid, primBox);
+    if (!range) return;
+    const auto& [first, last] = *range;
+    if (options.method == OverlapMethod::BBox) {
+      for (int64_t k = first[2]; k <= last[2]; ++k)
+        for (int64_t j = first[1]; j <= last[1]; ++j)
+          for (int64_t i = first[0]; i <= last[0]; ++i) emit(i, j, k);
+      local.tested += range->count();
+      return;
+    }
+    auto box = [&](int64_t i, int64_t j, int64_t k) {
+      return Box{{boundary[0][i], boundary[1][j], boundary[2][k]},
+                 {boundary[0][i + 1], boundary[1][j + 1], boundary[2][k + 1]}};
+    };
+    if (options.method == OverlapMethod::Center) {
+      // The course's quick test: the cell's centre inside the footprint (bounding box, or the sphere itself).
+      Mat4 toObject;
+      if (!isTri) toObject = inverse(scene.spheres[id - nTri].transform);
+      for (int64_t k = first[2]; k <= last[2]; ++k)
+        for (int64_t j = first[1]; j <= last[1]; ++j)
+          for (int64_t i = first[0]; i <= last[0]; ++i) {
+            const Box b = box(i, j, k);
+            const Vec3 c = (b.lo + b.hi) * 0.5;
+            bool take;
+            if (isTri) {
+              take = c.x >= primBox.lo.x && c.x <= primBox.hi.x && c.y >= primBox.lo.y && c.y <= primBox.hi.y &&
+                     c.z >= primBox.lo.z && c.z <= primBox.hi.z;
+            } else {
+              const Sphere& s = scene.spheres[id - nTri];
+              const Vec3 d = transformPoint(toObject, c) - s.center;
+              take = dot(d, d) <= s.radius * s.radius;
+            }
+            if (take) emit(i, j, k);
+          }
+      local.tested += range->count();
+      return;
+    }
+    if (!isTri) {
+      const Sphere& s = scene.spheres[id - nTri];
+      for (int64_t k = first[2]; k <= last[2]; ++k)
+        for (int64_t j = first[1]; j <= last[1]; ++j)
+          for (int64_t i = first[0]; i <= last[0]; ++i) {
+            bool fallback = false;
+            const bool hit = options.method == OverlapMethod::Sat ? sphereBoxSat(s, box(i, j, k))
+                                                                   : sphereBoxFiltered(s, box(i, j, k), &fallback);
+            local.fallbacks += fallback;
+            if (hit) emit(i, j, k);
+          }
+      local.tested += range->count();
+      return;
+    }
+    const Triangle& t = scene.triangles[id];
+    if (options.method == OverlapMethod::Sat) {
+      for (int64_t k = first[2]; k <= last[2]; ++k)
+        for (int64_t j = first[1]; j <= last[1]; ++j)
+          for (int64_t i = first[0]; i <= last[0]; ++i)
+            if (triangleBoxSat(t, box(i, j, k))) emit(i, j, k);
+      local.tested += range->count();
+      return;
+    }
+    // Exact: the filter decides; CGAL only where it cannot.
+    const TriangleFilter filter(t);
+    if (isDegenerate(t)) ++local.degenerate;
+    for (int64_t k = first[2]; k <= last[2]; ++k) {
+      for (int64_t j = first[1]; j <= last[1]; ++j) {
+        for (int64_t i = first[0]; i <= last[0]; ++i) {
+          const Box b = box(i, j, k);
+          const FilterResult r = filter.test(b.lo, b.hi, b.lo - filter.origin, b.hi - filter.origin);
+          bool hit = r == FilterResult::Overlap;
+          if (r == FilterResult::Unknown) {
+            ++local.fallbacks;
+            hit = triangleBoxExact(t, b);
+          }
+          if (hit) emit(i, j, k);
+        }
+      }
+    }
+    local.tested += range->count();
+  };
+
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nBounded, 256), [&](const tbb::blocked_range<size_t>& r) {
+    if (cancelled.load(std::memory_order_relaxed)) return;
+    Local& local = locals.local();
+    for (size_t id = r.begin(); id != r.end(); ++id) voxelizePrimitive(id, local);
+    const size_t finished = done.fetch_add(r.size()) + r.size();
+    if (options.progress && !options.progress(0.9 * double(finished) / double(nBounded))) cancelled = true;
+  });
+  if (cancelled) fail<Error>("voxelization cancelled");
+
+  // Gather the references of all threads and group them by cell.
+  VoxelizeStats local{};
+  size_t total = 0;
+  for (auto& l : locals) {
+    total += packed ? l.packedRefs.size() : l.pairRefs.size();
+    local.cellsTested += l.tested;
+    local.exactFallbacks += l.fallbacks;
+    local.degenerateTriangles += l.degenerate;
+    grid.outsidePrims.insert(grid.outsidePrims.end(), l.outside.begin(), l.outside.end());
+  }
+  std::sort(grid.outsidePrims.begin(), grid.outsidePrims.end());
+  grid.primIds.reserve(total);
+  grid.cellKeys.clear();
+  grid.cellStart.clear();
+  auto appendRef = [&](uint64_t key, uint32_t prim) {
+    if (grid.cellKeys.empty() || grid.cellKeys.back() != key) {
+      grid.cellKeys.push_back(key);
+      grid.cellStart.push_back(grid.primIds.size());
+    }
+    grid.primIds.push_back(prim);
+  };
+  if (packed) {
+    std::vector<uint64_t> all;
+    all.reserve(total);
+    for (auto& l : locals) {
+      all.insert(all.end(), l.packedRefs.begin(), l.packedRefs.end());
+      std::vector<uint64_t>().swap(l.packedRefs);
+    }
+    radixSort(all, primBits + keyBits);
+    for (uint64_t x : all) appendRef(x >> primBits, uint32_t(x & primMask));
+  } else {
+    std::vector<std::pair<uint64_t, uint32_t>> all;
+    all.reserve(total);
+    for (auto& l : locals) {
+      all.insert(all.end(), l.pairRefs.begin(), l.pairRefs.end());
+      std::vector<std::pair<uint64_t, uint32_t>>().swap(l.pairRefs);
+    }
+    tbb::parallel_sort(all.begin(), all.end());
+    for (const auto& [key, prim] : all) appendRef(key, prim);
+  }
+  grid.cellStart.push_back(grid.primIds.size());
+  if (options.progress) options.progress(1.0);
+  local.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (stats) *stats = local;
+  return grid;
+}
+
+}  // namespace vox

@@ -1,0 +1,723 @@
+// Tests for the scene importers (import_course.cpp, import_obj.cpp, import_gltf.cpp, import_ply.cpp,
+// load_scene.cpp): counts of the seed scenes, transforms against hand-computed values, and bad input.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <set>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+#include "vox/error.h"
+#include "vox/import.h"
+
+namespace vox {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string seed(const std::string& rel) { return std::string(VOX_SEED_DIR) + "/" + rel; }
+std::string course(const std::string& name) { return seed("6837/scenes/" + name); }
+
+// A fresh directory per test, removed afterwards.
+class TempDir {
+ public:
+  TempDir() {
+    static std::atomic<int> counter{0};
+    path_ = fs::temp_directory_path() /
+            ("vox_import_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  std::string write(const std::string& name, const std::string& content) const {
+    const std::string p = (path_ / name).string();
+    std::ofstream(p, std::ios::binary) << content;
+    return p;
+  }
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  fs::path path_;
+};
+
+// Runs `f`, expects an InputError whose message contains every one of `parts`.
+void expectInputError(const std::function<void()>& f, const std::vector<std::string>& parts) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    for (const auto& p : parts) EXPECT_NE(what.find(p), std::string::npos) << "'" << p << "' not in: " << what;
+    return;
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected InputError, got another exception: " << e.what();
+    return;
+  }
+  ADD_FAILURE() << "expected InputError, nothing thrown";
+}
+
+void expectNear(const Vec3& a, const Vec3& b, double tol = 1e-12) {
+  EXPECT_NEAR(a.x, b.x, tol);
+  EXPECT_NEAR(a.y, b.y, tol);
+  EXPECT_NEAR(a.z, b.z, tol);
+}
+
+bool hasVertex(const std::vector<Triangle>& tris, const Vec3& p, double tol = 1e-12) {
+  for (const auto& t : tris)
+    for (const auto& v : t.v)
+      if (std::fabs(v.x - p.x) <= tol && std::fabs(v.y - p.y) <= tol && std::fabs(v.z - p.z) <= tol) return true;
+  return false;
+}
+
+size_t countWarnings(const Scene& s, const std::string& needle) {
+  return std::count_if(s.warnings.begin(), s.warnings.end(),
+                       [&](const std::string& w) { return w.find(needle) != std::string::npos; });
+}
+
+// A minimal course scene around `group` (a Group body), with one material and one light.
+std::string courseScene(const std::string& group, int materials = 1) {
+  std::string out =
+      "PerspectiveCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 angle 30 }\n"
+      "Lights { numLights 1 DirectionalLight { direction 0 0 -1 color 1 1 1 } }\n"
+      "Materials { numMaterials " +
+      std::to_string(materials) + "\n";
+  for (int i = 0; i < materials; ++i) out += "  Material { diffuseColor 1 0 0 }\n";
+  return out + "}\n" + group;
+}
+
+// ---------------------------------------------------------------- course format: seed scenes
+
+TEST(ImportCourse, Scene5_02HasFourSpheres) {
+  const Scene s = loadScene(course("scene5_02_spheres.txt"));
+  ASSERT_EQ(s.spheres.size(), 4u);
+  EXPECT_TRUE(s.triangles.empty());
+  EXPECT_TRUE(s.planes.empty());
+  const std::vector<Vec3> centres{{1, 1, 1}, {-1, -1, 1}, {-1, 1, -1}, {1, -1, -1}};
+  for (size_t i = 0; i < 4; ++i) {
+    expectNear(s.spheres[i].center, centres[i], 0);
+    EXPECT_EQ(s.spheres[i].radius, 0.5);
+    EXPECT_FALSE(s.spheres[i].isEllipsoid());
+  }
+  ASSERT_TRUE(s.camera);
+  EXPECT_EQ(s.camera->kind, CameraKind::Orthographic);
+  EXPECT_EQ(s.lights.size(), 2u);
+}
+
+TEST(ImportCourse, Scene5_04HasFiveSpheresAndAPlane) {
+  const Scene s = loadScene(course("scene5_04_plane_test.txt"));
+  EXPECT_EQ(s.spheres.size(), 5u);
+  ASSERT_EQ(s.planes.size(), 1u);
+  expectNear(s.planes[0].normal, {0, 1, 0}, 0);
+  EXPECT_EQ(s.planes[0].offset, -2);
+  ASSERT_TRUE(s.camera);
+  EXPECT_EQ(s.camera->kind, CameraKind::Perspective);
+}
+
+TEST(ImportCourse, Scene5_09Has40000TrianglesInTheReadmeBounds) {
+  const Scene s = loadScene(course("scene5_09_bunny_mesh_40k.txt"));
+  ASSERT_EQ(s.triangles.size(), 40000u);
+  const auto box = sceneBounds(s);
+  ASSERT_TRUE(box);
+  // seed-scenes/6837/README.md: bunny_40k.obj bbox (-0.18932 0.06666 -0.123542) -> (0.121998 0.374318 0.117505)
+  expectNear(box->lo, {-0.18932, 0.06666, -0.123542}, 1e-6);
+  expectNear(box->hi, {0.121998, 0.374318, 0.117505}, 1e-6);
+}
+
+TEST(ImportCourse, Scene6_12PointLightsAndGem) {
+  const Scene s = loadScene(course("scene6_12_faceted_gem.txt"));
+  EXPECT_EQ(s.triangles.size(), 110u);  // diamond.obj
+  EXPECT_EQ(s.planes.size(), 1u);
+  ASSERT_EQ(s.lights.size(), 3u);
+  EXPECT_EQ(s.lights[0].kind, LightKind::Point);
+  expectNear(s.lights[0].position, {3, 5, 0}, 0);
+  expectNear(s.lights[0].attenuation, {0, 0, 0.025}, 0);
+}
+
+TEST(ImportCourse, Scene5_11RotatedTriangle) {
+  const Scene s = loadScene(course("scene5_11_rotated_triangles.txt"));
+  ASSERT_EQ(s.triangles.size(), 4u);
+  EXPECT_EQ(s.triangles[0].material, 0u);
+  EXPECT_EQ(s.triangles[1].material, 0u);
+  EXPECT_EQ(s.triangles[2].material, 1u);
+  EXPECT_EQ(s.triangles[3].material, 2u);
+  // ZRotate 0 leaves the triangle as written.
+  expectNear(s.triangles[2].v[0], {-2, -2, 0}, 0);
+  expectNear(s.triangles[2].v[1], {2, 1, 0}, 0);
+  // ZRotate 45: (x, y) -> ((x - y) / sqrt2, (x + y) / sqrt2).
+  const double r = 1 / std::sqrt(2.0);
+  expectNear(s.triangles[3].v[0], {0, -4 * r, 2});
+  expectNear(s.triangles[3].v[1], {1 * r, 3 * r, 2});
+  expectNear(s.triangles[3].v[2], {-1 * r, 3 * r, 2});
+}
+
+TEST(ImportCourse, Scene5_12NestedTransformsComposeOutermostFirst) {
+  const Scene s = loadScene(course("scene5_12_nested_transformations.txt"));
+  ASSERT_EQ(s.triangles.size(), 36u);  // three cube.obj
+  std::vector<Triangle> byMaterial[3];
+  for (const auto& t : s.triangles) byMaterial[t.material].push_back(t);
+  ASSERT_EQ(byMaterial[0].size(), 12u);
+  ASSERT_EQ(byMaterial[2].size(), 12u);
+  // Cube vertex (1,1,1) through UniformScale .5 * Translate(-.5,-2,0) * Translate(-3,0,3), innermost first.
+  EXPECT_TRUE(hasVertex(byMaterial[0], {-1.25, -0.5, 2}));
+  // ... and through the deepest chain, ending with Translate(0,1,0) ZRotate 45 Translate(0,-1,0).
+  const double h = std::sqrt(2.0) / 2;
+  EXPECT_TRUE(hasVertex(byMaterial[2], {0.5 * h + 1.25, h + 0.5, -1}, 1e-12));
+  // The middle cube: y = 1 -> Scale 1 2 1 -> 2 -> Translate 0 1 0 -> 3 -> Translate(-.5,-2,0) -> 1 -> * .5.
+  double yMax = -1e300;
+  for (const auto& t : s.triangles)
+    if (t.material == 1)
+      for (const auto& v : t.v) yMax = std::max(yMax, v.y);
+  EXPECT_DOUBLE_EQ(yMax, 0.5);
+}
+
+TEST(ImportCourse, Scene2_13SquashedRotatedSphereIsAnEllipsoid) {
+  const Scene s = loadScene(course("scene2_13_rotated_squashed_sphere.txt"));
+  ASSERT_EQ(s.spheres.size(), 1u);
+  const Sphere& e = s.spheres[0];
+  EXPECT_TRUE(e.isEllipsoid());
+  EXPECT_EQ(e.radius, 1);
+  expectNear(e.center, {0, 0, 0}, 0);
+  // ZRotate 45 * Scale 1 0.2 1.
+  const double c = std::cos(M_PI / 4), sn = std::sin(M_PI / 4);
+  EXPECT_NEAR(e.transform.m[0][0], c, 1e-15);
+  EXPECT_NEAR(e.transform.m[0][1], -sn * 0.2, 1e-15);
+  EXPECT_NEAR(e.transform.m[1][0], sn, 1e-15);
+  EXPECT_NEAR(e.transform.m[1][1], c * 0.2, 1e-15);
+  EXPECT_EQ(e.transform.m[2][2], 1);
+}
+
+TEST(ImportCourse, Scene6_15ProceduralMaterialsTakeTheirFirstColour) {
+  const Scene s = loadScene(course("scene6_15_marble_cubes.txt"));
+  ASSERT_EQ(s.materials.size(), 12u);
+  EXPECT_EQ(s.triangles.size(), 48u);
+  for (size_t procedural : {2u, 5u, 8u, 11u}) {
+    const Vec3 first = s.materials[procedural - 2].diffuse;
+    expectNear(s.materials[procedural].diffuse, first, 0);
+  }
+  EXPECT_EQ(countWarnings(s, "Noise"), 2u);
+  EXPECT_EQ(countWarnings(s, "Marble"), 2u);
+  for (const auto& t : s.triangles) EXPECT_TRUE(t.material % 3 == 2);
+}
+
+TEST(ImportCourse, AllEightyFiveSeedScenesParse) {
+  std::vector<fs::path> files;
+  for (const auto& entry : fs::directory_iterator(seed("6837/scenes")))
+    if (entry.path().extension() == ".txt") files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  ASSERT_EQ(files.size(), 85u);
+  for (const auto& f : files) {
+    SCOPED_TRACE(f.filename().string());
+    Scene s;
+    ASSERT_NO_THROW(s = loadScene(f.string()));
+    EXPECT_GT(s.primitiveCount(), 0u);
+    EXPECT_FALSE(s.materials.empty());
+    EXPECT_TRUE(s.camera.has_value());
+    EXPECT_LE(s.triangles.size(), 40000u + 13852u);
+    for (const auto& t : s.triangles) ASSERT_LT(t.material, s.materials.size());
+    for (const auto& sp : s.spheres) ASSERT_GT(sp.radius, 0);
+    for (const auto& p : s.planes) ASSERT_NEAR(length(p.normal), 1, 1e-12);
+  }
+}
+
+TEST(ImportCourse, CountsOfSelectedSeedScenes) {
+  struct Expected {
+    const char* file;
+    size_t triangles, spheres, planes;
+  };
+  const Expected table[] = {
+      {"scene1_01.txt", 0, 1, 0},
+      {"scene5_01_sphere.txt", 0, 1, 0},
+      {"scene5_05_sphere_triangles.txt", 2, 1, 0},
+      {"scene5_06_bunny_mesh_200.txt", 200, 0, 0},
+      {"scene5_08_bunny_mesh_5k.txt", 5000, 0, 0},
+      {"scene5_10_scale_translate.txt", 0, 6, 0},
+      {"scene6_07_bunny_mesh_40k.txt", 40000, 0, 1},
+      {"scene6_14_glass_sphere.txt", 36, 1, 1},
+      {"scene6_17_marble_vase.txt", 3840, 0, 1},
+      {"scene6_18_6.837_logo.txt", 13852, 0, 1},
+      {"scene7_01_sphere_triangle.txt", 1, 1, 0},
+  };
+  for (const auto& e : table) {
+    SCOPED_TRACE(e.file);
+    const Scene s = loadScene(course(e.file));
+    EXPECT_EQ(s.triangles.size(), e.triangles);
+    EXPECT_EQ(s.spheres.size(), e.spheres);
+    EXPECT_EQ(s.planes.size(), e.planes);
+  }
+}
+
+// ---------------------------------------------------------------- course format: fixtures
+
+TEST(ImportCourse, SimilarityFoldsIntoCentreAndRadius) {
+  TempDir dir;
+  const std::string path = dir.write(
+      "fold.txt", courseScene("Group { numObjects 2 MaterialIndex 0\n"
+                              "Transform { Translate 1 2 3 UniformScale 2 Sphere { center 1 0 0 radius 0.5 } }\n"
+                              "Transform { ZRotate 30 UniformScale 3 Sphere { center 0 1 0 radius 1 } }\n"
+                              "}\n"));
+  const Scene s = loadScene(path);
+  ASSERT_EQ(s.spheres.size(), 2u);
+  EXPECT_FALSE(s.spheres[0].isEllipsoid());
+  expectNear(s.spheres[0].center, {3, 2, 3}, 0);
+  EXPECT_EQ(s.spheres[0].radius, 1);
+  EXPECT_FALSE(s.spheres[1].isEllipsoid());
+  EXPECT_NEAR(s.spheres[1].radius, 3, 1e-14);
+  expectNear(s.spheres[1].center, {-3 * std::sin(M_PI / 6), 3 * std::cos(M_PI / 6), 0}, 1e-14);
+}
+
+TEST(ImportCourse, NonUniformScaleKeepsTheEllipsoid) {
+  TempDir dir;
+  const std::string path = dir.write(
+      "ell.txt", courseScene("Group { numObjects 1 MaterialIndex 0\n"
+                             "Transform { Translate 1 0 0 Scale 1 1 1.0000001 Sphere { center 0 0 2 radius 1 } }\n"
+                             "}\n"));
+  const Scene s = loadScene(path);
+  ASSERT_EQ(s.spheres.size(), 1u);
+  EXPECT_TRUE(s.spheres[0].isEllipsoid());
+  expectNear(s.spheres[0].center, {0, 0, 2}, 0);  // object space
+  EXPECT_EQ(s.spheres[0].transform.m[0][3], 1);
+  EXPECT_EQ(s.spheres[0].transform.m[2][2], 1.0000001);
+}
+
+TEST(ImportCourse, PlaneTransformUsesInverseTranspose) {
+  TempDir dir;
+  const std::string path = dir.write(
+      "planes.txt",
+      courseScene("Group { numObjects 2 MaterialIndex 0\n"
+                  "Transform { Translate 0 5 0 ZRotate 90 Plane { normal 2 0 0 offset 4 } }\n"
+                  "Transform { Scale 1 2 1 Plane { normal 0 1 1 offset 1 } }\n"
+                  "}\n"));
+  const Scene s = loadScene(path);
+  ASSERT_EQ(s.planes.size(), 2u);
+  // x = 2 turned to y = 2, then lifted by 5.
+  expectNear(s.planes[0].normal, {0, 1, 0}, 1e-15);
+  EXPECT_NEAR(s.planes[0].offset, 7, 1e-14);
+  // y + z = 1 stretched in y: y/2 + z = 1.
+  const Vec3 n = normalize(Vec3{0, 0.5, 1});
+  expectNear(s.planes[1].normal, n, 1e-15);
+  EXPECT_NEAR(s.planes[1].offset, 1 / length(Vec3{0, 0.5, 1}), 1e-15);
+}
+
+TEST(ImportCourse, RotateAndMatrixOps) {
+  TempDir dir;
+  // Matrix is multiplied on the left: M = Given * (Translate 1 0 0) -> scale x by 2 after translating.
+  const std::string path = dir.write(
+      "ops.txt", courseScene("Group { numObjects 2 MaterialIndex 0\n"
+                             "Transform { Rotate { 0 0 2 90 } Triangle { vertex0 1 0 0 vertex1 0 1 0 vertex2 0 0 1 } }\n"
+                             "Transform { Translate 1 0 0 Matrix { 2 0 0 0  0 1 0 0  0 0 1 0  0 0 0 1 }\n"
+                             "  Triangle { vertex0 1 0 0 vertex1 0 1 0 vertex2 0 0 1 } }\n"
+                             "}\n"));
+  const Scene s = loadScene(path);
+  ASSERT_EQ(s.triangles.size(), 2u);
+  expectNear(s.triangles[0].v[0], {0, 1, 0}, 0);
+  expectNear(s.triangles[0].v[1], {-1, 0, 0}, 0);
+  expectNear(s.triangles[1].v[0], {4, 0, 0}, 0);  // (1 + 1) * 2
+  expectNear(s.triangles[1].v[1], {2, 1, 0}, 0);
+}
+
+TEST(ImportCourse, DefaultsWithoutLightsMaterialsOrBackground) {
+  TempDir dir;
+  const std::string path = dir.write("bare.txt", "Group { numObjects 1 Sphere { center 0 0 0 radius 1 } }\n");
+  const Scene s = loadScene(path);
+  ASSERT_EQ(s.materials.size(), 1u);
+  expectNear(s.materials[0].diffuse, {1, 1, 1}, 0);
+  expectNear(s.background, {0.5, 0.5, 0.5}, 0);
+  expectNear(s.ambient, {1, 1, 1}, 0);  // forced: no lights
+  EXPECT_EQ(countWarnings(s, "no lights"), 1u);
+  EXPECT_FALSE(s.camera);
+}
+
+TEST(ImportCourse, ObjectBeforeMaterialIndexUsesMaterialZeroWithAWarning) {
+  TempDir dir;
+  const std::string path = dir.write(
+      "nomat.txt", courseScene("Group { numObjects 2 Sphere { center 0 0 0 radius 1 }\n"
+                               "MaterialIndex 1 Sphere { center 0 0 0 radius 1 } }\n",
+                               2));
+  const Scene s = loadScene(path);
+  ASSERT_EQ(s.spheres.size(), 2u);
+  EXPECT_EQ(s.spheres[0].material, 0u);
+  EXPECT_EQ(s.spheres[1].material, 1u);
+  EXPECT_EQ(countWarnings(s, "before any MaterialIndex"), 1u);
+}
+
+TEST(ImportCourse, LastTopLevelGroupWinsAndMaterialIndexIsGlobal) {
+  TempDir dir;
+  const std::string path = dir.write(
+      "twogroups.txt",
+      courseScene("Group { numObjects 1 MaterialIndex 1 Sphere { center 0 0 0 radius 1 } }\n"
+                  "Group { numObjects 2 Triangle { vertex0 0 0 0 vertex1 1 0 0 vertex2 0 1 0 }\n"
+                  "  Group { numObjects 1 MaterialIndex 2 Sphere { center 0 0 0 radius 2 } } }\n",
+                  3));
+  const Scene s = loadScene(path);
+  ASSERT_EQ(s.triangles.size(), 1u);
+  ASSERT_EQ(s.spheres.size(), 1u);
+  EXPECT_EQ(s.triangles[0].material, 1u);  // set in the first Group, still current
+  EXPECT_EQ(s.spheres[0].radius, 2);
+  EXPECT_EQ(s.spheres[0].material, 2u);
+}
+
+TEST(ImportCourse, TriangleMeshMatchesTheObjImporter) {
+  // The course's strict reader (double) and tinyobjloader (float) agree on cube.obj's integer coordinates.
+  const Scene viaCourse = loadScene(course("scene2_08_cube.txt"));
+  const Scene viaObj = loadScene(course("cube.obj"));
+  ASSERT_EQ(viaObj.triangles.size(), 12u);
+  ASSERT_EQ(viaCourse.triangles.size(), 12u);
+  // scene2_08 has no Transform around the cube.
+  for (size_t i = 0; i < 12; ++i)
+    for (int k = 0; k < 3; ++k) expectNear(viaCourse.triangles[i].v[k], viaObj.triangles[i].v[k], 0);
+}
+
+// ---------------------------------------------------------------- course format: bad input
+
+TEST(ImportCourse, MissingMeshFileNamesSceneLineAndMesh) {
+  TempDir dir;
+  const std::string path =
+      dir.write("missing.txt", courseScene("Group { numObjects 1 MaterialIndex 0\n"
+                                           "TriangleMesh {\n obj_file nowhere.obj\n } }\n"));
+  expectInputError([&] { loadScene(path); }, {"missing.txt:7:", "nowhere.obj"});
+}
+
+TEST(ImportCourse, FaceIndexOutOfRangeNamesTheObjFileAndLine) {
+  TempDir dir;
+  dir.write("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n");
+  const std::string path =
+      dir.write("badmesh.txt", courseScene("Group { numObjects 1 MaterialIndex 0\n"
+                                           "TriangleMesh { obj_file bad.obj } }\n"));
+  expectInputError([&] { loadScene(path); }, {"bad.obj:5:", "out of range"});
+  dir.write("zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n");
+  const std::string zero =
+      dir.write("zeromesh.txt", courseScene("Group { numObjects 1 MaterialIndex 0\n"
+                                            "TriangleMesh { obj_file zero.obj } }\n"));
+  expectInputError([&] { loadScene(zero); }, {"zero.obj:4:"});
+}
+
+TEST(ImportCourse, NanAndInfinityAreRefused) {
+  TempDir dir;
+  for (const char* bad : {"nan", "NaN", "inf", "-inf", "infinity", "1e999"}) {
+    SCOPED_TRACE(bad);
+    const std::string path = dir.write(
+        "nan.txt", courseScene(std::string("Group { numObjects 1 MaterialIndex 0\nSphere { center 0 ") + bad +
+                               " 0 radius 1 } }\n"));
+    expectInputError([&] { loadScene(path); }, {"nan.txt:6:", "bad number"});
+  }
+  dir.write("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
+  const std::string mesh =
+      dir.write("nanmesh.txt", courseScene("Group { numObjects 1 MaterialIndex 0\n"
+                                           "TriangleMesh { obj_file nan.obj } }\n"));
+  expectInputError([&] { loadScene(mesh); }, {"nan.obj:2:"});
+}
+
+TEST(ImportCourse, MalformedScenesNameFileAndLine) {
+  TempDir dir;
+  struct Case {
+    std::string body, needle;
+  };
+  const Case cases[] = {
+      {"Group { numObjects 1 MaterialIndex 0\nSpheer { center 0 0 0 radius 1 } }\n", ":6: unknown object 'Spheer'"},
+      {"Grope { }\n", ":5: unknown keyword 'Grope'"},
+      {"Group { numObjects 1 MaterialIndex 0\nSphere { center 0 0 0 radius 1.5x } }\n", ":6: bad number '1.5x'"},
+      {"Group { numObjects -1 }\n", ":5: negative count"},
+      {"Group { numObjects 1 MaterialIndex 3\nSphere { center 0 0 0 radius 1 } }\n", ":5: MaterialIndex 3 out of range"},
+      {"Group { numObjects 2 MaterialIndex 0\nSphere { center 0 0 0 radius 1 } }\n", ":6: Group ends after 1 of its 2"},
+      {"Group { numObjects 1 MaterialIndex 0\nSphere { center 0 0 0 radius 1 \n", "unexpected end of file"},
+      {"Group { numObjects 1 MaterialIndex 0\nSphere center 0 0 0 radius 1 } }\n", ":6: expected '{'"},
+      {"Group { numObjects 1 MaterialIndex 0\nSphere { center 0 0 0 radius -1 } }\n", "not positive"},
+      {"Group { numObjects 1 MaterialIndex 0\nTransform { Scale 1 0 1 Sphere { center 0 0 0 radius 1 } } }\n",
+       "singular"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.body);
+    const std::string path = dir.write("bad.txt", courseScene(c.body));
+    expectInputError([&] { loadScene(path); }, {"bad.txt", c.needle});
+  }
+}
+
+TEST(ImportCourse, TruncatedSeedSceneIsRefused) {
+  TempDir dir;
+  std::ifstream in(course("scene6_14_glass_sphere.txt"), std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(text.size(), 100u);
+  // Every cut inside the final Group must be an error, never a crash or a silent success. Cuts that end with a
+  // complete top-level block are valid files, so only cuts after the Group's opening are checked.
+  const size_t groupStart = text.rfind("Group");
+  ASSERT_NE(groupStart, std::string::npos);
+  const size_t lastBrace = text.rfind('}');
+  for (size_t cut = groupStart + 6; cut < lastBrace; cut += 7) {
+    const std::string path = dir.write("cut.txt", text.substr(0, cut));
+    dir.write("cube.obj", "v -1 -1 -1\nv 1 -1 -1\nv -1 1 -1\nf 1 2 3\n");
+    expectInputError([&] { loadScene(path); }, {"cut.txt"});
+  }
+}
+
+// ---------------------------------------------------------------- OBJ
+
+TEST(ImportObj, SeedMeshCounts) {
+  EXPECT_EQ(loadScene(seed("meshes/spot.obj")).triangles.size(), 5856u);
+  EXPECT_EQ(loadScene(seed("meshes/teapot.obj")).triangles.size(), 6320u);
+  const Scene bunny = loadScene(seed("meshes/derived/stanford_bunny_69k.obj"));
+  EXPECT_EQ(bunny.triangles.size(), 69451u);
+  const auto box = sceneBounds(bunny);
+  ASSERT_TRUE(box);
+  expectNear(box->lo, {-0.0946899, 0.0329874, -0.0618736}, 1e-6);
+  expectNear(box->hi, {0.0610091, 0.187321, 0.0587997}, 1e-6);
+  ASSERT_EQ(bunny.materials.size(), 1u);
+}
+
+TEST(ImportObj, QuadsTriangulatedAndMtlColours) {
+  TempDir dir;
+  dir.write("m.mtl", "newmtl blue\nKd 0.25 0.5 0.75\nKs 0.5 0.5 0.5\nNs 40\n");
+  const std::string path = dir.write("q.obj",
+                                     "mtllib m.mtl\n"
+                                     "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\n"
+                                     "f 1 2 5\n"
+                                     "usemtl blue\n"
+                                     "f 1 2 3 4\n");
+  const Scene s = loadScene(path);
+  ASSERT_EQ(s.triangles.size(), 3u);
+  ASSERT_EQ(s.materials.size(), 2u);  // blue, then the default for the first face
+  const Material& blue = s.materials[s.triangles[1].material];
+  EXPECT_EQ(blue.name, "blue");
+  EXPECT_NEAR(blue.diffuse.x, 0.25, 1e-7);
+  EXPECT_NEAR(blue.diffuse.z, 0.75, 1e-7);
+  EXPECT_NEAR(blue.specular.y, 0.5, 1e-7);
+  EXPECT_EQ(blue.exponent, 40);
+  EXPECT_EQ(s.triangles[2].material, s.triangles[1].material);
+  const Material& plain = s.materials[s.triangles[0].material];
+  expectNear(plain.diffuse, {1, 1, 1}, 0);
+  EXPECT_NE(s.triangles[0].material, s.triangles[1].material);
+}
+
+TEST(ImportObj, IndexOutOfRangeIsAnErrorNamingFileAndLine) {
+  TempDir dir;
+  const std::string tri = dir.write("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 7\n");
+  expectInputError([&] { loadScene(tri); }, {"tri.obj:5:", "out of range"});
+  // tinyobjloader silently drops a quad with a bad index; we must not.
+  const std::string quad = dir.write("quad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 4 9\n");
+  expectInputError([&] { loadScene(quad); }, {"quad.obj:5:"});
+  const std::string negative = dir.write("neg.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n");
+  expectInputError([&] { loadScene(negative); }, {"neg.obj"});
+  const std::string zero = dir.write("zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n");
+  expectInputError([&] { loadScene(zero); }, {"zero.obj"});
+}
+
+TEST(ImportObj, MissingFileAndNan) {
+  TempDir dir;
+  expectInputError([&] { loadScene(dir.file("absent.obj")); }, {"absent.obj"});
+  const std::string nan = dir.write("nan.obj", "v 0 0 0\nv 1 0 0\nv 0 nan 0\nf 1 2 3\n");
+  // tinyobjloader reads "nan" as a number or as 0; either a NaN that validateScene refuses or a finite value.
+  try {
+    const Scene s = loadScene(nan);
+    for (const auto& t : s.triangles)
+      for (const auto& v : t.v) EXPECT_TRUE(isFinite(v));
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("nan.obj"), std::string::npos);
+  }
+}
+
+// ---------------------------------------------------------------- glTF
+
+TEST(ImportGltf, BoxGltfAndGlbGiveIdenticalTriangles) {
+  const Scene a = loadScene(seed("gltf/Box/glTF/Box.gltf"));
+  const Scene b = loadScene(seed("gltf/Box/glTF-Binary/Box.glb"));
+  ASSERT_EQ(a.triangles.size(), 12u);
+  ASSERT_EQ(b.triangles.size(), 12u);
+  for (size_t i = 0; i < 12; ++i)
+    for (int k = 0; k < 3; ++k) expectNear(a.triangles[i].v[k], b.triangles[i].v[k], 0);
+  // The root node's column-major matrix translates by (0, 0, 2) (in this copy of the sample); the box is +-0.5.
+  const auto box = sceneBounds(a);
+  ASSERT_TRUE(box);
+  expectNear(box->lo, {-0.5, -0.5, 1.5}, 0);
+  expectNear(box->hi, {0.5, 0.5, 2.5}, 0);
+  ASSERT_GE(a.materials.size(), 1u);
+  EXPECT_NEAR(a.materials[a.triangles[0].material].diffuse.x, 0.8, 1e-7);
+  EXPECT_EQ(a.materials[a.triangles[0].material].diffuse.y, 0);
+}
+
+TEST(ImportGltf, DuckHasACamera) {
+  const Scene s = loadScene(seed("gltf/Duck/glTF/Duck.gltf"));
+  EXPECT_EQ(s.triangles.size(), 4212u);
+  ASSERT_TRUE(s.camera);
+  EXPECT_EQ(s.camera->kind, CameraKind::Perspective);
+  EXPECT_NEAR(s.camera->fovDegrees, 0.6605925559997559 * 180 / M_PI, 1e-9);
+  // Camera node matrix translation (400.113, 463.264, -431.078) under the root's 0.01 scale.
+  expectNear(s.camera->center, {4.00113, 4.63264, -4.31078}, 1e-5);
+  EXPECT_EQ(loadScene(seed("gltf/Duck/glTF-Binary/Duck.glb")).triangles.size(), 4212u);
+}
+
+TEST(ImportGltf, BoxTexturedEmbeddedWarnsAboutTextures) {
+  const Scene s = loadScene(seed("gltf/BoxTextured/glTF-Embedded/BoxTextured.gltf"));
+  EXPECT_EQ(s.triangles.size(), 12u);
+  EXPECT_EQ(countWarnings(s, "texture"), 1u);
+}
+
+TEST(ImportGltf, CamerasTakesTheFirstCameraNode) {
+  const Scene s = loadScene(seed("gltf/Cameras/glTF/Cameras.gltf"));
+  EXPECT_EQ(s.triangles.size(), 2u);
+  ASSERT_TRUE(s.camera);
+  EXPECT_EQ(s.camera->kind, CameraKind::Perspective);
+  EXPECT_NEAR(s.camera->fovDegrees, 0.7 * 180 / M_PI, 1e-12);
+  expectNear(s.camera->center, {0.5, 0.5, 3}, 0);
+  expectNear(s.camera->direction, {0, 0, -1}, 0);
+  expectNear(s.camera->up, {0, 1, 0}, 0);
+}
+
+TEST(ImportGltf, SphereLightsFound) {
+  const Scene s = loadScene(seed("gltf/sphere_lights/sphere_lights.gltf"));
+  EXPECT_EQ(s.triangles.size(), 224u);
+  ASSERT_EQ(s.lights.size(), 4u);
+  size_t directional = 0, point = 0;
+  for (const auto& l : s.lights) (l.kind == LightKind::Directional ? directional : point)++;
+  EXPECT_EQ(directional, 1u);
+  EXPECT_EQ(point, 3u);  // one point and two spots
+  EXPECT_EQ(countWarnings(s, "spot light"), 2u);
+  for (const auto& l : s.lights) {
+    EXPECT_LE(l.color.x, 1);
+    if (l.kind == LightKind::Directional) EXPECT_NEAR(length(l.direction), 1, 1e-12);
+  }
+}
+
+TEST(ImportGltf, SheenClothLoadsDespiteRequiredExtensions) {
+  const Scene s = loadScene(seed("gltf/SheenCloth/glTF/SheenCloth.gltf"));
+  EXPECT_EQ(s.triangles.size(), 115200u);
+  const auto box = sceneBounds(s);
+  ASSERT_TRUE(box);
+  expectNear(box->lo, {-0.0273633, 0.0000999381, -0.0484818}, 1e-6);
+  expectNear(box->hi, {0.0447657, 0.0404023, 0.0228422}, 1e-6);
+}
+
+TEST(ImportGltf, TruncatedGlbIsAnInputError) {
+  TempDir dir;
+  std::ifstream in(seed("gltf/Box/glTF-Binary/Box.glb"), std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_EQ(bytes.size(), 1664u);
+  for (size_t cut : {0u, 3u, 12u, 20u, 100u, 1000u, 1600u, 1663u}) {
+    SCOPED_TRACE(cut);
+    const std::string path = dir.write("cut.glb", bytes.substr(0, cut));
+    expectInputError([&] { loadScene(path); }, {"cut.glb"});
+  }
+}
+
+// A one-mesh glTF with an external buffer, written by the test, for the range checks.
+struct TinyGltf {
+  std::string accessorCount = "3";
+  std::string indexValues = "0 1 2";
+  std::string mode = "4";
+  std::string node = R"("translation": [1, 2, 3], "scale": [2, 2, 2])";
+
+  std::string write(const TempDir& dir) const {
+    std::string bin(36, '\0');
+    const float p[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    std::memcpy(bin.data(), p, 36);
+    std::vector<uint16_t> idx;
+    std::istringstream in(indexValues);
+    for (int v; in >> v;) idx.push_back(static_cast<uint16_t>(v));
+    std::string ib(idx.size() * 2, '\0');
+    std::memcpy(ib.data(), idx.data(), ib.size());
+    while (ib.size() % 4) ib.push_back('\0');
+    dir.write("tiny.bin", bin + ib);
+    const std::string json = R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+      "nodes": [{"mesh": 0, )" + node + R"(}],
+      "meshes": [{"name": "tri", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "mode": )" +
+                             mode + R"(}]}],
+      "buffers": [{"uri": "tiny.bin", "byteLength": )" +
+                             std::to_string(bin.size() + ib.size()) + R"(}],
+      "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
+                      {"buffer": 0, "byteOffset": 36, "byteLength": )" +
+                             std::to_string(idx.size() * 2) + R"(}],
+      "accessors": [{"bufferView": 0, "componentType": 5126, "count": )" +
+                             accessorCount + R"(, "type": "VEC3"},
+                    {"bufferView": 1, "componentType": 5123, "count": )" +
+                             std::to_string(idx.size()) + R"(, "type": "SCALAR"}]})";
+    return dir.write("tiny.gltf", json);
+  }
+};
+
+TEST(ImportGltf, TinyFixtureAppliesTrs) {
+  TempDir dir;
+  const Scene s = loadScene(TinyGltf{}.write(dir));
+  ASSERT_EQ(s.triangles.size(), 1u);
+  expectNear(s.triangles[0].v[0], {1, 2, 3}, 0);
+  expectNear(s.triangles[0].v[1], {3, 2, 3}, 0);
+  expectNear(s.triangles[0].v[2], {1, 4, 3}, 0);
+  ASSERT_EQ(s.materials.size(), 1u);  // default
+  // T * R * S: a 90-degree turn about z (quaternion (0, 0, sin45, cos45)) after scaling by 2, then translation.
+  TinyGltf rotated;
+  rotated.node = R"("translation": [1, 0, 0], "rotation": [0, 0, 0.7071067811865476, 0.7071067811865476],
+                   "scale": [2, 1, 1])";
+  const Scene r = loadScene(rotated.write(dir));
+  expectNear(r.triangles[0].v[1], {1, 2, 0}, 1e-15);  // (1,0,0) -> (2,0,0) -> (0,2,0) -> (1,2,0)
+  expectNear(r.triangles[0].v[2], {0, 0, 0}, 1e-15);  // (0,1,0) -> (0,1,0) -> (-1,0,0) -> (0,0,0)
+}
+
+TEST(ImportGltf, StripsConvertAndLinesAreSkipped) {
+  TempDir dir;
+  TinyGltf strip;
+  strip.mode = "5";
+  strip.indexValues = "0 1 2 0";
+  EXPECT_EQ(loadScene(strip.write(dir)).triangles.size(), 2u);
+  TinyGltf lines;
+  lines.mode = "1";
+  lines.indexValues = "0 1";
+  const Scene s = loadScene(lines.write(dir));
+  EXPECT_TRUE(s.triangles.empty());
+  EXPECT_EQ(countWarnings(s, "mesh 0 'tri'"), 1u);
+}
+
+TEST(ImportGltf, OutOfRangeAccessorAndIndexAreErrors) {
+  TempDir dir;
+  TinyGltf longAccessor;
+  longAccessor.accessorCount = "4";  // 48 bytes asked of a 36-byte bufferView
+  expectInputError([&] { loadScene(longAccessor.write(dir)); }, {"tiny.gltf", "accessor 0"});
+  TinyGltf badIndex;
+  badIndex.indexValues = "0 1 5";
+  expectInputError([&] { loadScene(badIndex.write(dir)); }, {"tiny.gltf", "accessor 1", "index 5"});
+  TinyGltf hugeCount;
+  hugeCount.accessorCount = "4611686018427387904";
+  expectInputError([&] { loadScene(hugeCount.write(dir)); }, {"tiny.gltf"});
+}
+
+// ---------------------------------------------------------------- PLY and dispatch
+
+TEST(ImportPly, StanfordBunnyMatchesItsObjConversion) {
+  const Scene ply = loadScene(seed("meshes/bun_zipper.ply"));
+  ASSERT_EQ(ply.triangles.size(), 69451u);
+  const Scene obj = loadScene(seed("meshes/derived/stanford_bunny_69k.obj"));
+  ASSERT_EQ(obj.triangles.size(), ply.triangles.size());
+  for (size_t i = 0; i < ply.triangles.size(); i += 97)
+    for (int k = 0; k < 3; ++k) expectNear(ply.triangles[i].v[k], obj.triangles[i].v[k], 1e-6);
+}
+
+TEST(ImportPly, SmallAsciiAndTruncated) {
+  TempDir dir;
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  const std::string quad = dir.write("quad.ply", header + "0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n");
+  const Scene s = loadScene(quad);
+  EXPECT_EQ(s.triangles.size(), 2u);
+  const std::string cut = dir.write("cut.ply", header + "0 0 0\n1 0 0\n");
+  expectInputError([&] { loadScene(cut); }, {"cut.ply"});
+  const std::string notPly = dir.write("junk.ply", "hello\n");
+  expectInputError([&] { loadScene(notPly); }, {"junk.ply"});
+}
+
+TEST(ImportDispatch, ExtensionIsCaseInsensitiveAndUnknownIsRefused) {
+  TempDir dir;
+  fs::copy_file(course("cube.obj"), dir.file("CUBE.OBJ"));
+  EXPECT_EQ(loadScene(dir.file("CUBE.OBJ")).triangles.size(), 12u);
+  const std::string odd = dir.write("scene.xyz", "whatever");
+  expectInputError([&] { loadScene(odd); }, {"scene.xyz", "unknown scene format"});
+  expectInputError([&] { loadScene(dir.file("nothing.txt")); }, {"nothing.txt"});
+}
+
+}  // namespace
+}  // namespace vox

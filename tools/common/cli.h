@@ -1,0 +1,50 @@
+// Command-line plumbing shared by the tools' mains: CLI11 parsing with STYLE.md exit codes, --threads, --version.
+#pragma once
+
+#include <tbb/global_control.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "vox/tool.h"
+
+namespace vox::cli {
+
+// Options every tool takes.
+struct CommonOptions {
+  bool quiet = false;
+  unsigned threads = 0;  // 0: all cores
+};
+
+inline void addCommonOptions(CLI::App& app, CommonOptions& common) {
+  app.set_version_flag("--version", std::string("libvox ") + versionString());
+  app.add_flag("-q,--quiet", common.quiet, "No progress bar or warnings on stderr");
+  app.add_option("--threads", common.threads, "Worker threads (default: all cores)")->check(CLI::Range(1u, 4096u));
+}
+
+// Parses argv; returns an exit code when the tool should stop now (help, version: 0; bad usage: 1).
+inline std::optional<int> parse(CLI::App& app, int argc, char** argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "%s: error: %s\n", app.get_name().c_str(), e.what());
+    std::fprintf(stderr, "Run with --help for usage.\n");
+    return kExitUsage;
+  }
+  return std::nullopt;
+}
+
+// Limits TBB to the requested thread count for the lifetime of the returned object.
+inline std::unique_ptr<tbb::global_control> limitThreads(unsigned threads) {
+  if (threads == 0) return nullptr;
+  return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
+}
+
+}  // namespace vox::cli

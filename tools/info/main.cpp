@@ -1,0 +1,27 @@
+// vox-info: statistics of a grid file, as text or JSON, on stdout.
+#include <cstdio>
+
+#include "../common/cli.h"
+#include "vox/grid_file.h"
+#include "vox/info.h"
+
+int main(int argc, char** argv) {
+  std::string path;
+  vox::InfoOptions options;
+  vox::cli::CommonOptions common;
+  CLI::App app{"Print the bounds, dimensions, method, primitive counts, occupied cells, references, memory and a "
+               "histogram of primitives per cell of a grid file.",
+               "vox-info"};
+  app.add_option("grid", path, "Grid file (.vgrid)")->required();
+  app.add_flag("--json", options.json, "One JSON object instead of text");
+  app.add_flag("--cells", options.cells, "With --json: every occupied cell and its primitive ids")->needs("--json");
+  app.add_flag("--primitives", options.primitives, "With --json: every primitive in world space")->needs("--json");
+  vox::cli::addCommonOptions(app, common);
+  if (auto code = vox::cli::parse(app, argc, argv)) return *code;
+  return vox::runTool("vox-info", [&] {
+    const vox::GridFile file = vox::readGridFile(path);
+    const std::string text = vox::formatGridInfo(file, options);
+    std::fwrite(text.data(), 1, text.size(), stdout);
+    return std::fflush(stdout) == 0 ? vox::kExitOk : vox::kExitCannotWrite;
+  });
+}

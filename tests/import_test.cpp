@@ -383,7 +383,7 @@ TEST(ImportCourse, MissingMeshFileNamesSceneLineAndMesh) {
   const std::string path =
       dir.write("missing.txt", courseScene("Group { numObjects 1 MaterialIndex 0\n"
                                            "TriangleMesh {\n obj_file nowhere.obj\n } }\n"));
-  expectInputError([&] { loadScene(path); }, {"missing.txt:7:", "nowhere.obj"});
+  expectInputError([&] { loadScene(path); }, {"missing.txt:8:", "nowhere.obj"});
 }
 
 TEST(ImportCourse, FaceIndexOutOfRangeNamesTheObjFileAndLine) {
@@ -407,7 +407,7 @@ TEST(ImportCourse, NanAndInfinityAreRefused) {
     const std::string path = dir.write(
         "nan.txt", courseScene(std::string("Group { numObjects 1 MaterialIndex 0\nSphere { center 0 ") + bad +
                                " 0 radius 1 } }\n"));
-    expectInputError([&] { loadScene(path); }, {"nan.txt:6:", "bad number"});
+    expectInputError([&] { loadScene(path); }, {"nan.txt:7:", "bad number"});
   }
   dir.write("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
   const std::string mesh =
@@ -422,14 +422,14 @@ TEST(ImportCourse, MalformedScenesNameFileAndLine) {
     std::string body, needle;
   };
   const Case cases[] = {
-      {"Group { numObjects 1 MaterialIndex 0\nSpheer { center 0 0 0 radius 1 } }\n", ":6: unknown object 'Spheer'"},
-      {"Grope { }\n", ":5: unknown keyword 'Grope'"},
-      {"Group { numObjects 1 MaterialIndex 0\nSphere { center 0 0 0 radius 1.5x } }\n", ":6: bad number '1.5x'"},
-      {"Group { numObjects -1 }\n", ":5: negative count"},
-      {"Group { numObjects 1 MaterialIndex 3\nSphere { center 0 0 0 radius 1 } }\n", ":5: MaterialIndex 3 out of range"},
-      {"Group { numObjects 2 MaterialIndex 0\nSphere { center 0 0 0 radius 1 } }\n", ":6: Group ends after 1 of its 2"},
+      {"Group { numObjects 1 MaterialIndex 0\nSpheer { center 0 0 0 radius 1 } }\n", ":7: unknown object 'Spheer'"},
+      {"Grope { }\n", ":6: unknown keyword 'Grope'"},
+      {"Group { numObjects 1 MaterialIndex 0\nSphere { center 0 0 0 radius 1.5x } }\n", ":7: bad number '1.5x'"},
+      {"Group { numObjects -1 }\n", ":6: negative count"},
+      {"Group { numObjects 1 MaterialIndex 3\nSphere { center 0 0 0 radius 1 } }\n", ":6: MaterialIndex 3 out of range"},
+      {"Group { numObjects 2 MaterialIndex 0\nSphere { center 0 0 0 radius 1 } }\n", ":7: Group ends after 1 of its 2"},
       {"Group { numObjects 1 MaterialIndex 0\nSphere { center 0 0 0 radius 1 \n", "unexpected end of file"},
-      {"Group { numObjects 1 MaterialIndex 0\nSphere center 0 0 0 radius 1 } }\n", ":6: expected '{'"},
+      {"Group { numObjects 1 MaterialIndex 0\nSphere center 0 0 0 radius 1 } }\n", ":7: expected '{'"},
       {"Group { numObjects 1 MaterialIndex 0\nSphere { center 0 0 0 radius -1 } }\n", "not positive"},
       {"Group { numObjects 1 MaterialIndex 0\nTransform { Scale 1 0 1 Sphere { center 0 0 0 radius 1 } } }\n",
        "singular"},
@@ -525,14 +525,20 @@ TEST(ImportObj, MissingFileAndNan) {
 
 // ---------------------------------------------------------------- glTF
 
-TEST(ImportGltf, BoxGltfAndGlbGiveIdenticalTriangles) {
+TEST(ImportGltf, BoxGltfAndGlbShareGeometryUnderTheirOwnRootMatrices) {
+  // The two seed copies hold the same buffer (byte for byte) but different root-node matrices: Box.gltf
+  // translates by (0, 0, 2), Box.glb rotates by -90 degrees about x (column-major [1,0,0,0, 0,0,-1,0, 0,1,0,0, ...],
+  // i.e. (x, y, z) -> (x, z, -y)). So the world triangles must match after undoing each matrix, which also checks
+  // that node matrices are read column-major.
   const Scene a = loadScene(seed("gltf/Box/glTF/Box.gltf"));
   const Scene b = loadScene(seed("gltf/Box/glTF-Binary/Box.glb"));
   ASSERT_EQ(a.triangles.size(), 12u);
   ASSERT_EQ(b.triangles.size(), 12u);
   for (size_t i = 0; i < 12; ++i)
-    for (int k = 0; k < 3; ++k) expectNear(a.triangles[i].v[k], b.triangles[i].v[k], 0);
-  // The root node's column-major matrix translates by (0, 0, 2) (in this copy of the sample); the box is +-0.5.
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 w = b.triangles[i].v[k];
+      expectNear(a.triangles[i].v[k], {w.x, -w.z, w.y + 2}, 0);
+    }
   const auto box = sceneBounds(a);
   ASSERT_TRUE(box);
   expectNear(box->lo, {-0.5, -0.5, 1.5}, 0);
@@ -540,6 +546,7 @@ TEST(ImportGltf, BoxGltfAndGlbGiveIdenticalTriangles) {
   ASSERT_GE(a.materials.size(), 1u);
   EXPECT_NEAR(a.materials[a.triangles[0].material].diffuse.x, 0.8, 1e-7);
   EXPECT_EQ(a.materials[a.triangles[0].material].diffuse.y, 0);
+  EXPECT_EQ(a.materials[a.triangles[0].material].name, "Red");
 }
 
 TEST(ImportGltf, DuckHasACamera) {
@@ -581,7 +588,9 @@ TEST(ImportGltf, SphereLightsFound) {
   EXPECT_EQ(countWarnings(s, "spot light"), 2u);
   for (const auto& l : s.lights) {
     EXPECT_LE(l.color.x, 1);
-    if (l.kind == LightKind::Directional) EXPECT_NEAR(length(l.direction), 1, 1e-12);
+    if (l.kind == LightKind::Directional) {
+      EXPECT_NEAR(length(l.direction), 1, 1e-12);
+    }
   }
 }
 

@@ -95,13 +95,12 @@ Accel buildAccel(const Scene& scene, const Grid& grid, AccelKind kind) {
   accel.alwaysTested.erase(std::unique(accel.alwaysTested.begin(), accel.alwaysTested.end()),
                            accel.alwaysTested.end());
 
-  if (kind == AccelKind::Grid) {
-    for (uint32_t id : grid.primIds)
-      if (id >= firstPlane) fail<InputError>("grid: cell primitive id ", id, " is not a bounded primitive");
-    if (grid.occupiedCount() >= kSolidCell)
-      fail<LimitError>("grid has ", grid.occupiedCount(), " occupied cells; at most 2^32 - 2 can be traced");
-    buildTables(accel, grid);
-  }
+  // The cell lookup is built for both kinds: the voxels and count modes walk the grid whatever the accel.
+  for (uint32_t id : grid.primIds)
+    if (id >= firstPlane) fail<InputError>("grid: cell primitive id ", id, " is not a bounded primitive");
+  if (grid.occupiedCount() >= kSolidCell)
+    fail<LimitError>("grid has ", grid.occupiedCount(), " occupied cells; at most 2^32 - 2 can be traced");
+  buildTables(accel, grid);
   return accel;
 }
 

@@ -151,6 +151,10 @@ Material getMaterial(ByteReader& r) {
 
 std::string encodeGridFile(const Scene& scene, const Grid& grid) {
   ByteWriter w;
+  // The header is filled in last, in place, so the (possibly large) payload is never copied.
+  w.bytes().reserve(kHeaderSize + 256 + scene.triangles.size() * 76 + grid.cellKeys.size() * 16 + grid.primIds.size() * 4 +
+                    scene.materials.size() * 128);
+  w.bytes().assign(kHeaderSize, '\0');
   // Scene.
   w.put(uint64_t(scene.materials.size()));
   for (const auto& m : scene.materials) putMaterial(w, m);
@@ -204,14 +208,16 @@ std::string encodeGridFile(const Scene& scene, const Grid& grid) {
   w.putArray(grid.outsidePrims);
   w.putArray(grid.solidKeys);
 
-  std::string payload = std::move(w.bytes());
-  ByteWriter header;
-  header.bytes().append(kMagic, 8);
-  header.put(kGridFileVersion);
-  header.put(uint32_t(0));  // flags, reserved
-  header.put(uint64_t(payload.size()));
-  header.put(checksum(payload.data(), payload.size()));
-  return header.bytes() + payload;
+  std::string bytes = std::move(w.bytes());
+  const uint64_t payloadSize = bytes.size() - kHeaderSize;
+  const uint64_t sum = checksum(bytes.data() + kHeaderSize, payloadSize);
+  const uint32_t version = kGridFileVersion, flags = 0;
+  std::memcpy(bytes.data(), kMagic, 8);
+  std::memcpy(bytes.data() + 8, &version, 4);
+  std::memcpy(bytes.data() + 12, &flags, 4);
+  std::memcpy(bytes.data() + 16, &payloadSize, 8);
+  std::memcpy(bytes.data() + 24, &sum, 8);
+  return bytes;
 }
 
 GridFile decodeGridFile(const std::string& bytes, const std::string& name) {

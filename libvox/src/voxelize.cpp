@@ -65,6 +65,40 @@ bool inside(const Box& inner, const Box& outer) {
   return true;
 }
 
+// Cells of a row (fixed indices on two axes) that a triangle's plane can reach: the triangle's cells lie within a
+// cell of its plane, so only those need the overlap test. The sweep axis is the normal's dominant one. The range is
+// widened by a margin far above the rounding error of the computed normal (and the plane is not used at all when
+// that normal is too uncertain), so the pruning never drops a cell the full test would take.
+struct PlaneSweep {
+  int axis = 0;
+  bool usable = false;
+  Vec3 n, origin;
+  double margin = 0;
+
+  PlaneSweep(const TriangleFilter& f, const Triangle& t, const Box& triBox) : n(f.normal), origin(t.v[0]) {
+    const Vec3 an{std::fabs(n.x), std::fabs(n.y), std::fabs(n.z)};
+    axis = an.x >= an.y && an.x >= an.z ? 0 : (an.y >= an.z ? 1 : 2);
+    const double na = an[axis];
+    const double relErr = (f.normalErr.x + f.normalErr.y + f.normalErr.z) / na;
+    if (!(na > 0) || !(relErr < 1e-6) || !f.usable) return;
+    const double diag = length(triBox.hi - triBox.lo);
+    margin = 1e-4 * diag + 1e-12 * (std::fabs(origin.x) + std::fabs(origin.y) + std::fabs(origin.z));
+    usable = true;
+  }
+
+  // Interval on `axis` of the plane over the rectangle [b0, b1] x [c0, c1] of the other two axes, widened.
+  std::pair<double, double> range(double b0, double b1, double c0, double c1) const {
+    const int b = (axis + 1) % 3, c = (axis + 2) % 3;
+    const double kb = -n[b] / n[axis], kc = -n[c] / n[axis];
+    const double pb0 = kb * (b0 - origin[b]), pb1 = kb * (b1 - origin[b]);
+    const double pc0 = kc * (c0 - origin[c]), pc1 = kc * (c1 - origin[c]);
+    const double lo = origin[axis] + std::min(pb0, pb1) + std::min(pc0, pc1);
+    const double hi = origin[axis] + std::max(pb0, pb1) + std::max(pc0, pc1);
+    const double m = margin + 1e-9 * (std::fabs(lo) + std::fabs(hi));
+    return {lo - m, hi + m};
+  }
+};
+
 double triangleArea(const Triangle& t) { return 0.5 * length(cross(t.v[1] - t.v[0], t.v[2] - t.v[0])); }
 
 // A generous estimate of the references a primitive makes: a surface of area A crosses at most about
@@ -240,32 +274,41 @@ Grid voxelizeScene(const Scene& scene, const VoxelizeOptions& options, VoxelizeS
       return;
     }
     const Triangle& t = scene.triangles[id];
-    if (options.method == OverlapMethod::Sat) {
-      for (int64_t k = first[2]; k <= last[2]; ++k)
-        for (int64_t j = first[1]; j <= last[1]; ++j)
-          for (int64_t i = first[0]; i <= last[0]; ++i)
-            if (triangleBoxSat(t, box(i, j, k))) emit(i, j, k);
-      local.tested += range->count();
-      return;
-    }
-    // Exact: the filter decides; CGAL only where it cannot.
     const TriangleFilter filter(t);
-    if (isDegenerate(t)) ++local.degenerate;
-    for (int64_t k = first[2]; k <= last[2]; ++k) {
-      for (int64_t j = first[1]; j <= last[1]; ++j) {
-        for (int64_t i = first[0]; i <= last[0]; ++i) {
-          const Box b = box(i, j, k);
-          const FilterResult r = filter.test(b.lo, b.hi, b.lo - filter.origin, b.hi - filter.origin);
-          bool hit = r == FilterResult::Overlap;
-          if (r == FilterResult::Unknown) {
-            ++local.fallbacks;
-            hit = triangleBoxExact(t, b);
-          }
-          if (hit) emit(i, j, k);
+    const bool sat = options.method == OverlapMethod::Sat;
+    if (!sat && isDegenerate(t)) ++local.degenerate;
+    const PlaneSweep sweep(filter, t, primBox);
+    const int a = sweep.axis, b = (a + 1) % 3, c = (a + 2) % 3;
+    int64_t idx[3];
+    for (idx[c] = first[c]; idx[c] <= last[c]; ++idx[c]) {
+      for (idx[b] = first[b]; idx[b] <= last[b]; ++idx[b]) {
+        int64_t from = first[a], to = last[a];
+        if (sweep.usable) {
+          const auto [lo, hi] = sweep.range(boundary[b][idx[b]], boundary[b][idx[b] + 1], boundary[c][idx[c]],
+                                            boundary[c][idx[c] + 1]);
+          const auto r = cellRange(grid.bounds, dims, a, lo, hi);
+          from = std::max(from, r[0]);
+          to = std::min(to, r[1]);
         }
+        for (idx[a] = from; idx[a] <= to; ++idx[a]) {
+          const Box bx = box(idx[0], idx[1], idx[2]);
+          bool hit;
+          if (sat) {
+            hit = triangleBoxSat(t, bx);
+          } else {
+            // Exact: the filter decides; CGAL only where it cannot.
+            const FilterResult r = filter.test(bx.lo, bx.hi, bx.lo - filter.origin, bx.hi - filter.origin);
+            hit = r == FilterResult::Overlap;
+            if (r == FilterResult::Unknown) {
+              ++local.fallbacks;
+              hit = triangleBoxExact(t, bx);
+            }
+          }
+          if (hit) emit(idx[0], idx[1], idx[2]);
+        }
+        local.tested += uint64_t(std::max<int64_t>(0, to - from + 1));
       }
     }
-    local.tested += range->count();
   };
 
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nBounded, 256), [&](const tbb::blocked_range<size_t>& r) {

@@ -64,8 +64,8 @@ struct Accel {
   std::span<const uint32_t> cellPrims(uint32_t occupiedIndex) const { return grid->cellPrims(occupiedIndex); }
 };
 
-// Prepares every primitive of `scene` and, for AccelKind::Grid, the cell lookup of `grid` (which must have been
-// built from `scene`; the Accel keeps a pointer to it). Throws InputError when the grid names primitive ids that
+// Prepares every primitive of `scene` and the cell lookup of `grid` (which must have been built from `scene`; the
+// Accel keeps a pointer to it). Throws InputError when the grid names primitive ids that
 // the scene does not have, vox::Error for a singular ellipsoid transform, LimitError when the grid has 2^32 - 2 or
 // more occupied cells.
 Accel buildAccel(const Scene& scene, const Grid& grid, AccelKind kind);

@@ -728,5 +728,19 @@ TEST(ImportDispatch, ExtensionIsCaseInsensitiveAndUnknownIsRefused) {
   expectInputError([&] { loadScene(dir.file("nothing.txt")); }, {"nothing.txt"});
 }
 
+TEST(ImportDispatch, EverySampleSceneInTheRepositoryLoads) {
+  size_t loaded = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(std::string(VOX_SOURCE_DIR) + "/scenes")) {
+    const std::string ext = entry.path().extension().string();
+    if (ext != ".txt" && ext != ".obj" && ext != ".gltf" && ext != ".glb" && ext != ".ply") continue;
+    SCOPED_TRACE(entry.path().string());
+    Scene s;
+    ASSERT_NO_THROW(s = loadScene(entry.path().string()));
+    EXPECT_GT(s.boundedCount(), 0u);
+    ++loaded;
+  }
+  EXPECT_GE(loaded, 12u);
+}
+
 }  // namespace
 }  // namespace vox

@@ -228,7 +228,7 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
   if (version > kGridFileVersion)
     fail<InputError>(name, ": grid file version ", version, " is newer than this build reads (", kGridFileVersion, ")");
   if (version == 0) fail<InputError>(name, ": byte 8: invalid grid file version 0");
-  header.get<uint32_t>();
+  if (header.get<uint32_t>() != 0) fail<InputError>(name, ": byte 12: unknown flags (written by a newer version?)");
   const uint64_t payloadSize = header.get<uint64_t>();
   const uint64_t expected = header.get<uint64_t>();
   if (payloadSize != bytes.size() - kHeaderSize) {
@@ -308,6 +308,9 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
     n = r.get<uint32_t>();
     if (n == 0 || n > (1u << 21)) r.corrupt("grid dimension " + std::to_string(n) + " out of range");
   }
+  for (int a = 0; a < 3; ++a)
+    if (cellBoundary(grid.bounds, grid.dims, a, grid.dims[a]) != grid.bounds.hi[a])
+      r.corrupt("grid bounds do not match the cell boundary formula");
   const uint8_t method = r.get<uint8_t>();
   if (method > uint8_t(OverlapMethod::Exact)) r.corrupt("unknown overlap method " + std::to_string(method));
   grid.method = OverlapMethod(method);

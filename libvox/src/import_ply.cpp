@@ -6,6 +6,9 @@
 //   with the header's `element face N` to report dropped faces as a warning.
 // - OpenMesh prints its complaints to std::cerr through omerr()/omlog(); the library must not print, so they are
 //   muted while reading (global streams: not thread-safe, like OpenMesh's own IO manager).
+// OpenMesh's Property.hh trips GCC 12's -Wmaybe-uninitialized (a false positive seen with -O1 and sanitizers) in
+// code instantiated here, so the warning is off for this file.
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 

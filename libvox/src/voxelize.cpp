@@ -34,6 +34,19 @@ Box paddedBounds(Box b) {
   return b;
 }
 
+// The boundary formula b(i) = lo + (hi - lo) * i / n need not give b(n) == hi in floating point, which would leave a
+// sliver of the bounds (and primitives lying on the top face) outside every cell. Nudge hi up by ulps until the
+// formula reproduces it exactly; the change is a few ulps at most.
+void alignUpperBounds(Grid& grid) {
+  for (int a = 0; a < 3; ++a) {
+    int steps = 0;
+    while (cellBoundary(grid.bounds, grid.dims, a, grid.dims[a]) != grid.bounds.hi[a]) {
+      grid.bounds.hi.at(a) = std::nextafter(grid.bounds.hi[a], HUGE_VAL);
+      if (++steps > 4096) fail<UsageError>("bounds on axis ", a, " cannot be divided into ", grid.dims[a], " cells");
+    }
+  }
+}
+
 void checkDims(const std::array<uint32_t, 3>& dims) {
   for (uint32_t n : dims)
     if (n == 0 || n > kMaxCellsPerAxis)
@@ -160,7 +173,7 @@ Grid planGrid(const Scene& scene, const VoxelizeOptions& options) {
   } else {
     grid.bounds = {{0, 0, 0}, {1, 1, 1}};
     grid.dims = {1, 1, 1};
-    return grid;
+    return grid;  // 0 + (1 - 0) * 1 / 1 == 1: already aligned
   }
   if (options.dims) {
     grid.dims = *options.dims;
@@ -170,6 +183,7 @@ Grid planGrid(const Scene& scene, const VoxelizeOptions& options) {
     grid.dims = defaultDims(grid.bounds, scene.boundedCount());
   }
   checkDims(grid.dims);
+  alignUpperBounds(grid);
   return grid;
 }
 

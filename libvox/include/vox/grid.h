@@ -48,6 +48,8 @@ inline std::array<uint32_t, 3> cellIndex(const std::array<uint32_t, 3>& dims, ui
 }
 
 // b_a(i) = lo_a + (hi_a - lo_a) * i / n_a, in double precision, evaluated exactly in this order. i in [0, n_a].
+// Every grid libvox makes or reads satisfies b_a(0) == lo_a and b_a(n_a) == hi_a exactly (planGrid nudges hi by a few
+// ulps where needed; readGridFile refuses a file that breaks it), so the cells tile the bounds without a sliver.
 inline double cellBoundary(const Box& bounds, const std::array<uint32_t, 3>& dims, int axis, int64_t i) {
   return bounds.lo[axis] + (bounds.hi[axis] - bounds.lo[axis]) * double(i) / double(dims[axis]);
 }

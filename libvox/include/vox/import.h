@@ -19,6 +19,13 @@ Scene importCourseScene(const std::string& path);
 Scene importObj(const std::string& path);
 // glTF 2.0 (.gltf, .glb) through tinygltf: node hierarchy (matrix or TRS), triangle primitives (indexed or not),
 // baseColorFactor, cameras, KHR_lights_punctual. Other primitive modes are skipped with a warning.
+// Scene: the default scene, else scene 0, else every root node. Triangle strips and fans are converted.
+// Camera: the first camera node in depth-first order; yfov (radians) -> fovDegrees, orthographic ymag ->
+// orthoHeight = 2 * ymag; looks down the node's -Z with +Y up. Materials: baseColorFactor RGB -> diffuse; base
+// colour textures are not sampled (one warning). Lights: directional along the node's -Z, point at the node's
+// origin, spot -> point (warning). glTF intensities are physical (lux, candela) and a Phong shader has no exposure
+// to map them, so Light::color = color * min(intensity, 1) and point lights get no distance falloff (attenuation
+// 1 0 0). Accessor, bufferView and index ranges are checked: InputError "file: accessor N: ...".
 Scene importGltf(const std::string& path);
 // PLY triangle meshes through OpenMesh.
 Scene importPly(const std::string& path);

@@ -1,0 +1,128 @@
+// Grid files: exact round trip; truncation at every byte and every single-bit flip refused with InputError.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "test_util.h"
+#include "vox/error.h"
+#include "vox/grid_file.h"
+#include "vox/voxelize.h"
+
+namespace vox {
+namespace {
+
+Scene sampleScene() {
+  Scene scene = testing::randomScene(21, 6, 2);
+  scene.materials.push_back({"red", {1, 0, 0}, {1, 1, 1}, 32, {}, {}, 1.5});
+  scene.triangles[1].material = 1;
+  scene.planes.push_back({{0, 1, 0}, -0.5, 1});
+  scene.camera = Camera{CameraKind::Orthographic, {0, 0, 5}, {0, 0, -1}, {0, 1, 0}, 30, 3};
+  scene.lights.push_back({LightKind::Point, {0, -1, 0}, {1, 2, 3}, {0.5, 0.5, 0.5}, {1, 0, 0.1}});
+  scene.background = {0.1, 0.2, 0.3};
+  scene.ambient = {0.05, 0.05, 0.05};
+  return scene;
+}
+
+bool sameVec(const Vec3& a, const Vec3& b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+
+TEST(GridFile, RoundTripsEverything) {
+  const Scene scene = sampleScene();
+  VoxelizeOptions opt;
+  opt.dims = {5, 4, 3};
+  opt.bounds = Box{{0.1, 0.1, 0.1}, {0.9, 0.9, 0.9}};
+  const Grid grid = voxelizeScene(scene, opt);
+  ASSERT_GT(grid.occupiedCount(), 0u);
+  testing::ScratchDir dir("gridfile");
+  const std::string path = dir.file("a.vgrid");
+  writeGridFile(path, scene, grid);
+  const GridFile back = readGridFile(path);
+  ASSERT_EQ(back.scene.triangles.size(), scene.triangles.size());
+  for (size_t i = 0; i < scene.triangles.size(); ++i) {
+    for (int k = 0; k < 3; ++k) EXPECT_TRUE(sameVec(back.scene.triangles[i].v[k], scene.triangles[i].v[k]));
+    EXPECT_EQ(back.scene.triangles[i].material, scene.triangles[i].material);
+  }
+  ASSERT_EQ(back.scene.spheres.size(), scene.spheres.size());
+  for (size_t i = 0; i < scene.spheres.size(); ++i) {
+    EXPECT_TRUE(sameVec(back.scene.spheres[i].center, scene.spheres[i].center));
+    EXPECT_EQ(back.scene.spheres[i].radius, scene.spheres[i].radius);
+    EXPECT_EQ(back.scene.spheres[i].transform.m, scene.spheres[i].transform.m);
+  }
+  ASSERT_EQ(back.scene.planes.size(), 1u);
+  EXPECT_EQ(back.scene.planes[0].offset, -0.5);
+  ASSERT_EQ(back.scene.materials.size(), 2u);
+  EXPECT_EQ(back.scene.materials[1].name, "red");
+  EXPECT_EQ(back.scene.materials[1].exponent, 32);
+  ASSERT_TRUE(back.scene.camera);
+  EXPECT_EQ(back.scene.camera->kind, CameraKind::Orthographic);
+  EXPECT_EQ(back.scene.camera->orthoHeight, 3);
+  ASSERT_EQ(back.scene.lights.size(), 1u);
+  EXPECT_TRUE(sameVec(back.scene.lights[0].attenuation, {1, 0, 0.1}));
+  EXPECT_TRUE(sameVec(back.scene.background, scene.background));
+  EXPECT_EQ(back.grid.dims, grid.dims);
+  EXPECT_TRUE(sameVec(back.grid.bounds.lo, grid.bounds.lo));
+  EXPECT_EQ(back.grid.method, grid.method);
+  EXPECT_EQ(back.grid.cellKeys, grid.cellKeys);
+  EXPECT_EQ(back.grid.cellStart, grid.cellStart);
+  EXPECT_EQ(back.grid.primIds, grid.primIds);
+  EXPECT_EQ(back.grid.outsidePrims, grid.outsidePrims);
+  // Same bytes again: encoding is deterministic.
+  EXPECT_EQ(encodeGridFile(back.scene, back.grid), encodeGridFile(scene, grid));
+}
+
+TEST(GridFile, EveryTruncationAndBitFlipIsRefused) {
+  const Scene scene = sampleScene();
+  VoxelizeOptions opt;
+  opt.dims = {3, 3, 3};
+  const std::string bytes = encodeGridFile(scene, voxelizeScene(scene, opt));
+  ASSERT_NO_THROW(decodeGridFile(bytes, "ok.vgrid"));
+  for (size_t n = 0; n < bytes.size(); ++n) {
+    try {
+      decodeGridFile(bytes.substr(0, n), "cut.vgrid");
+      FAIL() << "truncation at " << n << " accepted";
+    } catch (const InputError& e) {
+      ASSERT_NE(std::string(e.what()).find("cut.vgrid"), std::string::npos);
+    }
+  }
+  for (size_t bit = 0; bit < bytes.size() * 8; ++bit) {
+    std::string flipped = bytes;
+    flipped[bit / 8] = char(flipped[bit / 8] ^ (1 << (bit % 8)));
+    EXPECT_THROW(decodeGridFile(flipped, "flip.vgrid"), InputError) << "bit " << bit;
+  }
+}
+
+TEST(GridFile, ParserChecksStructureEvenWithAValidChecksum) {
+  // A file whose checksum is right but whose cell table lies: written by a buggy or hostile writer.
+  const Scene scene = sampleScene();
+  VoxelizeOptions opt;
+  opt.dims = {3, 3, 3};
+  Grid grid = voxelizeScene(scene, opt);
+  Grid badKeys = grid;
+  std::swap(badKeys.cellKeys[0], badKeys.cellKeys[1]);
+  EXPECT_THROW(decodeGridFile(encodeGridFile(scene, badKeys), "x"), InputError);
+  Grid badIds = grid;
+  badIds.primIds[0] = 1000;
+  EXPECT_THROW(decodeGridFile(encodeGridFile(scene, badIds), "x"), InputError);
+  Grid badStart = grid;
+  badStart.cellStart.back() += 1;
+  EXPECT_THROW(decodeGridFile(encodeGridFile(scene, badStart), "x"), InputError);
+  Scene badMaterial = scene;
+  badMaterial.triangles[0].material = 9;
+  EXPECT_THROW(decodeGridFile(encodeGridFile(badMaterial, grid), "x"), InputError);
+}
+
+TEST(GridFile, NewerVersionAndMissingFile) {
+  const Scene scene = sampleScene();
+  std::string bytes = encodeGridFile(scene, voxelizeScene(scene, {}));
+  bytes[8] = char(kGridFileVersion + 1);
+  try {
+    decodeGridFile(bytes, "new.vgrid");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("newer"), std::string::npos);
+  }
+  EXPECT_THROW(readGridFile("/nonexistent/dir/x.vgrid"), InputError);
+  EXPECT_THROW(writeGridFile("/nonexistent/dir/x.vgrid", scene, {}), OutputError);
+}
+
+}  // namespace
+}  // namespace vox

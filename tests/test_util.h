@@ -1,0 +1,61 @@
+// Small helpers shared by the tests: temporary folders and random scenes.
+#pragma once
+
+#include <unistd.h>
+
+#include <atomic>
+#include <filesystem>
+#include <random>
+#include <string>
+
+#include "vox/scene.h"
+
+namespace vox::testing {
+
+class ScratchDir {
+ public:
+  explicit ScratchDir(const std::string& tag) {
+    static std::atomic<int> counter{0};
+    path_ = std::filesystem::temp_directory_path() /
+            ("vox_" + tag + "_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+    std::filesystem::remove_all(path_);
+    std::filesystem::create_directories(path_);
+  }
+  ~ScratchDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+// Random triangles (some degenerate, some tiny) and spheres (some ellipsoids) inside [lo, lo + size]^3.
+inline Scene randomScene(uint32_t seed, int triangles, int spheres, double lo = 0, double size = 1) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  auto point = [&] { return Vec3{lo + size * u(rng), lo + size * u(rng), lo + size * u(rng)}; };
+  Scene scene;
+  scene.materials.push_back({});
+  for (int i = 0; i < triangles; ++i) {
+    Triangle t;
+    t.v[0] = point();
+    const double extent = size * (i % 3 == 0 ? 0.4 : 0.08);
+    for (int k = 1; k < 3; ++k)
+      t.v[k] = t.v[0] + Vec3{extent * (u(rng) - 0.5), extent * (u(rng) - 0.5), extent * (u(rng) - 0.5)};
+    if (i % 17 == 5) t.v[2] = t.v[1];  // degenerate
+    scene.triangles.push_back(t);
+  }
+  for (int i = 0; i < spheres; ++i) {
+    Sphere s;
+    s.center = point();
+    s.radius = size * (0.02 + 0.15 * u(rng));
+    if (i % 2 == 1) s.transform = translation({0.01, 0, 0}) * rotation({1, 1, 0}, 20) * scaling({1, 0.5, 1.5});
+    scene.spheres.push_back(s);
+  }
+  return scene;
+}
+
+}  // namespace vox::testing

@@ -4,8 +4,8 @@
 namespace vox {
 
 bool triangleBoxFiltered(const Triangle& t, const Box& box, bool* usedFallback) {
-  const TriangleFilter filter(t);
-  const FilterResult r = filter.test(box.lo, box.hi, box.lo - filter.origin, box.hi - filter.origin);
+  TriangleFilter filter(t);
+  const FilterResult r = filter.test(box);
   if (usedFallback) *usedFallback = r == FilterResult::Unknown;
   if (r == FilterResult::Unknown) return triangleBoxExact(t, box);
   return r == FilterResult::Overlap;

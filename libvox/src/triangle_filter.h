@@ -21,45 +21,57 @@ namespace vox {
 
 enum class FilterResult { Disjoint, Overlap, Unknown };
 
+// Plain arrays rather than Vec3 so that the fixed-size loops below unroll into straight-line code.
 struct TriangleFilter {
-  Vec3 origin;                 // v0
-  Vec3 d[2];                   // v1 - v0, v2 - v0
-  Vec3 edges[3];               // v1 - v0, v2 - v1, v0 - v2
-  Vec3 normal, normalErr;      // d1 x d2 and its error bound per component
-  Vec3 triMin, triMax;         // exact bounding box of the vertices
+  double origin[3];            // v0
+  double edges[3][3];          // v1 - v0, v2 - v1, v0 - v2
+  double normal[3];            // (v1 - v0) x (v2 - v0)
+  double normalErr[3];         // error bound of each normal component
+  double triMin[3], triMax[3]; // exact bounding box of the vertices
   double edgeProj[3][3][2];    // [edge][axis] -> min, max of the triangle's projection
   double edgeProjErr[3][3];    // error bound of those projections
   bool usable = true;          // false: magnitudes outside the filter's range
 
   static constexpr double kU = DBL_EPSILON / 2;
   static constexpr double kTiny = 1e-300;
+  static constexpr int kNext[3] = {1, 2, 0};
+  static constexpr int kPrev[3] = {2, 0, 1};
 
   explicit TriangleFilter(const Triangle& t) {
-    origin = t.v[0];
-    d[0] = t.v[1] - t.v[0];
-    d[1] = t.v[2] - t.v[0];
-    edges[0] = d[0];
-    edges[1] = t.v[2] - t.v[1];
-    edges[2] = t.v[0] - t.v[2];
-    triMin = minVec(minVec(t.v[0], t.v[1]), t.v[2]);
-    triMax = maxVec(maxVec(t.v[0], t.v[1]), t.v[2]);
-    for (const auto& v : t.v)
-      for (int a = 0; a < 3; ++a)
-        if (std::fabs(v[a]) > 1e100) usable = false;
-    normal = cross(d[0], d[1]);
+    double v[3][3];
+    for (int k = 0; k < 3; ++k) {
+      v[k][0] = t.v[k].x;
+      v[k][1] = t.v[k].y;
+      v[k][2] = t.v[k].z;
+    }
+    double d[2][3];
     for (int a = 0; a < 3; ++a) {
-      const int b = (a + 1) % 3, c = (a + 2) % 3;
-      normalErr.at(a) = 8 * kU * (std::fabs(d[0][b] * d[1][c]) + std::fabs(d[0][c] * d[1][b])) + kTiny;
+      origin[a] = v[0][a];
+      d[0][a] = v[1][a] - v[0][a];
+      d[1][a] = v[2][a] - v[0][a];
+      edges[0][a] = d[0][a];
+      edges[1][a] = v[2][a] - v[1][a];
+      edges[2][a] = v[0][a] - v[2][a];
+      triMin[a] = std::min({v[0][a], v[1][a], v[2][a]});
+      triMax[a] = std::max({v[0][a], v[1][a], v[2][a]});
+      for (int k = 0; k < 3; ++k)
+        if (std::fabs(v[k][a]) > 1e100) usable = false;
+    }
+    for (int a = 0; a < 3; ++a) {
+      const int b = kNext[a], c = kPrev[a];
+      normal[a] = d[0][b] * d[1][c] - d[0][c] * d[1][b];
+      normalErr[a] = 8 * kU * (std::fabs(d[0][b] * d[1][c]) + std::fabs(d[0][c] * d[1][b])) + kTiny;
     }
     for (int i = 0; i < 3; ++i)
       for (int a = 0; a < 3; ++a) {
+        const int b = kNext[a], c = kPrev[a];
         double mn = 0, mx = 0, err = 0;  // vertex 0 projects to exactly 0
         for (int k = 0; k < 2; ++k) {
-          double m;
-          const double s = edgeProjection(i, a, d[k], &m);
+          const double t1 = edges[i][c] * d[k][b], t2 = edges[i][b] * d[k][c];
+          const double s = t1 - t2;
           mn = std::min(mn, s);
           mx = std::max(mx, s);
-          err = std::max(err, 8 * kU * m + kTiny);
+          err = std::max(err, 8 * kU * (std::fabs(t1) + std::fabs(t2)) + kTiny);
         }
         edgeProj[i][a][0] = mn;
         edgeProj[i][a][1] = mx;
@@ -67,49 +79,78 @@ struct TriangleFilter {
       }
   }
 
-  // Projection of q (relative to the origin) onto edges[i] x unit_a, and the magnitude of its terms.
-  double edgeProjection(int i, int a, const Vec3& q, double* magnitude) const {
-    const int b = (a + 1) % 3, c = (a + 2) % 3;
-    const double t1 = edges[i][c] * q[b], t2 = edges[i][b] * q[c];
-    *magnitude = std::fabs(t1) + std::fabs(t2);
-    return t1 - t2;
+  // Per-cell error bounds depend on |corner - origin| only through an upper bound qMax[a] of it on each axis, valid
+  // for every cell the caller will test (the voxelizer passes the extent of the triangle's cell range). Computing
+  // them once per triangle keeps the per-cell test to a few multiply-adds per axis.
+  double boxErr[3][3];  // [edge][axis]: total error bound of the comparison on that edge axis
+  double normalBoxErr;
+  int normalSel[3];     // per axis: 0 when the normal's box minimum uses the cell's low side, 1 for the high side
+  int edgeSel[3][3][2]; // [edge][axis][b or c]: likewise for the edge axes' minimum
+
+  void prepare(const double qMax[3]) {
+    for (int i = 0; i < 3; ++i)
+      for (int a = 0; a < 3; ++a) {
+        const int b = kNext[a], c = kPrev[a];
+        const double cb = edges[i][c], cc = -edges[i][b];
+        boxErr[i][a] = 8 * kU * (std::fabs(cb) * qMax[b] + std::fabs(cc) * qMax[c]) + kTiny + edgeProjErr[i][a];
+        edgeSel[i][a][0] = cb >= 0 ? 0 : 1;
+        edgeSel[i][a][1] = cc >= 0 ? 0 : 1;
+      }
+    double err = kTiny;
+    for (int a = 0; a < 3; ++a) {
+      err += qMax[a] * (normalErr[a] + 8 * kU * std::fabs(normal[a]));
+      normalSel[a] = normal[a] >= 0 ? 0 : 1;
+    }
+    normalBoxErr = 2 * err;
   }
 
-  // lo/hi: the closed cell. rel{Lo,Hi}: fl(lo - origin), fl(hi - origin), which the caller may cache per cell row.
-  FilterResult test(const Vec3& lo, const Vec3& hi, const Vec3& relLo, const Vec3& relHi) const {
+  // lo/hi: the closed cell. rel[0][a] = fl(lo[a] - origin[a]), rel[1][a] = fl(hi[a] - origin[a]), with
+  // |rel| <= qMax of the last prepare().
+  FilterResult test(const double lo[3], const double hi[3], const double rel[2][3]) const {
     // Box face normals: plain comparisons of inputs, no rounding at all.
     for (int a = 0; a < 3; ++a)
       if (triMin[a] > hi[a] || triMax[a] < lo[a]) return FilterResult::Disjoint;
     if (!usable) return FilterResult::Unknown;
     bool unknown = false;
+    // The triangle's normal: the triangle projects to exactly 0; the box to [min, max] of n . (corner - origin),
+    // reached at the corners the normal's signs select.
+    {
+      double boxMin = 0, boxMax = 0;
+      for (int a = 0; a < 3; ++a) {
+        boxMin += normal[a] * rel[normalSel[a]][a];
+        boxMax += normal[a] * rel[1 - normalSel[a]][a];
+      }
+      const double err = normalBoxErr;
+      if (boxMin > err || boxMax < -err) return FilterResult::Disjoint;
+      unknown |= !(boxMin < -err && boxMax > err);
+    }
     // Nine edge axes.
     for (int i = 0; i < 3; ++i)
       for (int a = 0; a < 3; ++a) {
-        const int b = (a + 1) % 3, c = (a + 2) % 3;
+        const int b = kNext[a], c = kPrev[a];
         const double cb = edges[i][c], cc = -edges[i][b];
-        const double qb0 = cb * relLo[b], qb1 = cb * relHi[b];
-        const double qc0 = cc * relLo[c], qc1 = cc * relHi[c];
-        const double boxMin = std::min(qb0, qb1) + std::min(qc0, qc1);
-        const double boxMax = std::max(qb0, qb1) + std::max(qc0, qc1);
-        const double boxErr = 8 * kU * (std::max(std::fabs(qb0), std::fabs(qb1)) + std::max(std::fabs(qc0), std::fabs(qc1))) + kTiny;
-        const double err = boxErr + edgeProjErr[i][a];
+        const int sb = edgeSel[i][a][0], sc = edgeSel[i][a][1];
+        const double boxMin = cb * rel[sb][b] + cc * rel[sc][c];
+        const double boxMax = cb * rel[1 - sb][b] + cc * rel[1 - sc][c];
+        const double err = boxErr[i][a];
         const double triMinP = edgeProj[i][a][0], triMaxP = edgeProj[i][a][1];
         if (triMinP - boxMax > err || boxMin - triMaxP > err) return FilterResult::Disjoint;
-        if (!(boxMax - triMinP > err && triMaxP - boxMin > err)) unknown = true;
+        unknown |= !(boxMax - triMinP > err && triMaxP - boxMin > err);
       }
-    // The triangle's normal: the triangle projects to exactly 0; the box to [min, max] of n . (corner - origin).
-    double boxMin = 0, boxMax = 0, err = kTiny;
-    for (int a = 0; a < 3; ++a) {
-      const double p0 = normal[a] * relLo[a], p1 = normal[a] * relHi[a];
-      boxMin += std::min(p0, p1);
-      boxMax += std::max(p0, p1);
-      const double q = std::max(std::fabs(relLo[a]), std::fabs(relHi[a]));
-      err += q * (normalErr[a] + 8 * kU * std::fabs(normal[a]));
-    }
-    err *= 2;
-    if (boxMin > err || boxMax < -err) return FilterResult::Disjoint;
-    if (!(boxMin < -err && boxMax > err)) unknown = true;
     return unknown ? FilterResult::Unknown : FilterResult::Overlap;
+  }
+
+  // One box on its own: prepares the bounds for it, then tests.
+  FilterResult test(const Box& box) {
+    const double lo[3] = {box.lo.x, box.lo.y, box.lo.z}, hi[3] = {box.hi.x, box.hi.y, box.hi.z};
+    double rel[2][3], qMax[3];
+    for (int a = 0; a < 3; ++a) {
+      rel[0][a] = lo[a] - origin[a];
+      rel[1][a] = hi[a] - origin[a];
+      qMax[a] = std::max(std::fabs(rel[0][a]), std::fabs(rel[1][a]));
+    }
+    prepare(qMax);
+    return test(lo, hi, rel);
   }
 };
 

@@ -72,6 +72,23 @@ std::optional<CellRange> rangeOf(const Grid& grid, const Box& box) {
   return r;
 }
 
+// cellRange on precomputed boundaries b[0..n] (b[n] == hi): a guess from the scale, then exact steps.
+std::array<int64_t, 2> rangeInBoundaries(const std::vector<double>& b, double scale, double lo, double hi) {
+  const int64_t n = int64_t(b.size()) - 1;
+  if (!(hi >= b[0]) || !(lo <= b[n])) return {1, 0};
+  auto guess = [&](double x) {
+    const double g = std::floor((x - b[0]) * scale);
+    return g < 0 ? int64_t(0) : (g > double(n - 1) ? n - 1 : int64_t(g));
+  };
+  int64_t first = guess(lo);
+  while (first > 0 && b[first] >= lo) --first;
+  while (first < n - 1 && b[first + 1] < lo) ++first;
+  int64_t last = guess(hi);
+  while (last < n - 1 && b[last + 1] <= hi) ++last;
+  while (last > 0 && b[last] > hi) --last;
+  return {first, last};
+}
+
 bool inside(const Box& inner, const Box& outer) {
   for (int a = 0; a < 3; ++a)
     if (inner.lo[a] < outer.lo[a] || inner.hi[a] > outer.hi[a]) return false;
@@ -88,11 +105,12 @@ struct PlaneSweep {
   Vec3 n, origin;
   double margin = 0;
 
-  PlaneSweep(const TriangleFilter& f, const Triangle& t, const Box& triBox) : n(f.normal), origin(t.v[0]) {
+  PlaneSweep(const TriangleFilter& f, const Triangle& t, const Box& triBox)
+      : n{f.normal[0], f.normal[1], f.normal[2]}, origin(t.v[0]) {
     const Vec3 an{std::fabs(n.x), std::fabs(n.y), std::fabs(n.z)};
     axis = an.x >= an.y && an.x >= an.z ? 0 : (an.y >= an.z ? 1 : 2);
     const double na = an[axis];
-    const double relErr = (f.normalErr.x + f.normalErr.y + f.normalErr.z) / na;
+    const double relErr = (f.normalErr[0] + f.normalErr[1] + f.normalErr[2]) / na;
     if (!(na > 0) || !(relErr < 1e-6) || !f.usable) return;
     const double diag = length(triBox.hi - triBox.lo);
     margin = 1e-4 * diag + 1e-12 * (std::fabs(origin.x) + std::fabs(origin.y) + std::fabs(origin.z));
@@ -208,6 +226,9 @@ Grid voxelizeScene(const Scene& scene, const VoxelizeOptions& options, VoxelizeS
     for (int64_t i = 0; i <= int64_t(grid.dims[a]); ++i) boundary[a][i] = cellBoundary(grid.bounds, grid.dims, a, i);
   }
 
+  std::array<double, 3> boundaryScale;
+  for (int a = 0; a < 3; ++a) boundaryScale[a] = double(grid.dims[a]) / (grid.bounds.hi[a] - grid.bounds.lo[a]);
+
   const int primBits = std::max(1, int(std::bit_width(uint64_t(nBounded - 1))));
   const int keyBits = int(std::bit_width(grid.cellCount() - 1));
   const bool packed = primBits + keyBits <= 64;
@@ -288,7 +309,15 @@ Grid voxelizeScene(const Scene& scene, const VoxelizeOptions& options, VoxelizeS
       return;
     }
     const Triangle& t = scene.triangles[id];
-    const TriangleFilter filter(t);
+    TriangleFilter filter(t);
+    {
+      // |corner - origin| over every cell of the range, for the filter's error bounds (rounded up generously).
+      double qMax[3];
+      for (int ax = 0; ax < 3; ++ax)
+        qMax[ax] = 1.0000001 * std::max(std::fabs(boundary[ax][first[ax]] - filter.origin[ax]),
+                                        std::fabs(boundary[ax][last[ax] + 1] - filter.origin[ax]));
+      filter.prepare(qMax);
+    }
     const bool sat = options.method == OverlapMethod::Sat;
     if (!sat && isDegenerate(t)) ++local.degenerate;
     const PlaneSweep sweep(filter, t, primBox);
@@ -300,22 +329,32 @@ Grid voxelizeScene(const Scene& scene, const VoxelizeOptions& options, VoxelizeS
         if (sweep.usable) {
           const auto [lo, hi] = sweep.range(boundary[b][idx[b]], boundary[b][idx[b] + 1], boundary[c][idx[c]],
                                             boundary[c][idx[c] + 1]);
-          const auto r = cellRange(grid.bounds, dims, a, lo, hi);
+          const auto r = rangeInBoundaries(boundary[a], boundaryScale[a], lo, hi);
           from = std::max(from, r[0]);
           to = std::min(to, r[1]);
         }
+        double lo[3], hi[3], rel[2][3];
+        for (int axis : {b, c}) {
+          lo[axis] = boundary[axis][idx[axis]];
+          hi[axis] = boundary[axis][idx[axis] + 1];
+          rel[0][axis] = lo[axis] - filter.origin[axis];
+          rel[1][axis] = hi[axis] - filter.origin[axis];
+        }
         for (idx[a] = from; idx[a] <= to; ++idx[a]) {
-          const Box bx = box(idx[0], idx[1], idx[2]);
+          lo[a] = boundary[a][idx[a]];
+          hi[a] = boundary[a][idx[a] + 1];
           bool hit;
           if (sat) {
-            hit = triangleBoxSat(t, bx);
+            hit = triangleBoxSat(t, Box{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}});
           } else {
             // Exact: the filter decides; CGAL only where it cannot.
-            const FilterResult r = filter.test(bx.lo, bx.hi, bx.lo - filter.origin, bx.hi - filter.origin);
+            rel[0][a] = lo[a] - filter.origin[a];
+            rel[1][a] = hi[a] - filter.origin[a];
+            const FilterResult r = filter.test(lo, hi, rel);
             hit = r == FilterResult::Overlap;
             if (r == FilterResult::Unknown) {
               ++local.fallbacks;
-              hit = triangleBoxExact(t, bx);
+              hit = triangleBoxExact(t, Box{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}});
             }
           }
           if (hit) emit(idx[0], idx[1], idx[2]);

@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages libvox needs, idempotently: nothing is fetched when all are present.
+# Usage: scripts/install-deps.sh [--bench] [--meshlab]
+set -euo pipefail
+packages=(build-essential cmake ninja-build pkg-config python3
+  libcgal-dev libopenmesh-dev libopenimageio-dev libtinygltf-dev libstb-dev nlohmann-json3-dev
+  libtinyobjloader-dev libtbb-dev libcli11-dev libgtest-dev)
+for arg in "$@"; do
+  case $arg in
+    --bench) packages+=(libbenchmark-dev libembree-dev libopenvdb-dev) ;;
+    --meshlab) packages+=(meshlab xvfb xauth) ;;
+    *) echo "install-deps.sh: unknown option $arg" >&2; exit 1 ;;
+  esac
+done
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+echo "install-deps.sh: installing ${missing[*]}" >&2
+SUDO=""
+[ "$(id -u)" = 0 ] || SUDO=sudo
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

@@ -6,6 +6,7 @@
 
 #include "../common/cli.h"
 #include "vox/error.h"
+#include "vox/fill.h"
 #include "vox/grid_file.h"
 #include "vox/import.h"
 #include "vox/progress.h"
@@ -21,6 +22,7 @@ struct Options {
   std::vector<double> bounds;
   std::string method = "exact";
   bool stats = false;
+  bool fill = false;
   vox::cli::CommonOptions common;
 };
 
@@ -50,8 +52,9 @@ int run(const Options& opt) {
     return true;
   };
   VoxelizeStats stats;
-  const Grid grid = voxelizeScene(scene, vo, &stats);
+  Grid grid = voxelizeScene(scene, vo, &stats);
   bar.finish();
+  if (opt.fill) fillSolid(grid, vo.memoryLimitBytes);
   if (!grid.outsidePrims.empty() && !opt.common.quiet)
     std::fprintf(stderr, "vox-voxelize: warning: %s: %zu primitives stick out of the given bounds (traced separately)\n",
                  opt.scene.c_str(), grid.outsidePrims.size());
@@ -63,12 +66,12 @@ int run(const Options& opt) {
     const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::fprintf(stderr,
                  "triangles: %zu\nspheres: %zu\nplanes: %zu\ndegenerate_triangles: %llu\ndims: %u %u %u\nmethod: %s\n"
-                 "cells_tested: %llu\nexact_fallbacks: %llu\noccupied_cells: %zu\nreferences: %zu\n"
+                 "cells_tested: %llu\nexact_fallbacks: %llu\noccupied_cells: %zu\nsolid_cells: %zu\nreferences: %zu\n"
                  "voxelize_seconds: %.6f\ntotal_seconds: %.6f\npeak_memory_mb: %.1f\n",
                  scene.triangles.size(), scene.spheres.size(), scene.planes.size(),
                  (unsigned long long)stats.degenerateTriangles, grid.dims[0], grid.dims[1], grid.dims[2],
                  methodName(grid.method).c_str(), (unsigned long long)stats.cellsTested,
-                 (unsigned long long)stats.exactFallbacks, grid.occupiedCount(), grid.referenceCount(), stats.seconds,
+                 (unsigned long long)stats.exactFallbacks, grid.occupiedCount(), grid.solidKeys.size(), grid.referenceCount(), stats.seconds,
                  total, double(usage.ru_maxrss) / 1024.0);
   }
   return kExitOk;
@@ -91,6 +94,7 @@ int main(int argc, char** argv) {
                  "Overlap test: exact (CGAL exact predicates, default), sat (floating-point separating axes), "
                  "bbox (primitive bounding box, superset), center (cell centre in footprint, misses cells)")
       ->check(CLI::IsMember({"exact", "sat", "bbox", "center"}));
+  app.add_flag("--fill", opt.fill, "Also mark the empty cells inside closed surfaces as solid");
   app.add_flag("--stats", opt.stats, "Print statistics (name: value) on stderr");
   vox::cli::addCommonOptions(app, opt.common);
   app.footer("Default grid: about " + std::to_string(int(vox::kCellsPerPrimitive)) +

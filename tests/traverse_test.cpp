@@ -536,7 +536,19 @@ void expectExactCoverage(const Grid& g, const Ray& ray, const std::string& what)
   GridWalker walker(g.bounds, g.dims, ray);
   std::set<std::array<int64_t, 3>> visited;
   WalkCell cell;
-  while (walker.next(cell)) visited.insert({cell.idx[0], cell.idx[1], cell.idx[2]});
+  while (walker.next(cell)) {
+    visited.insert({cell.idx[0], cell.idx[1], cell.idx[2]});
+    if (cell.extra) continue;
+    // The exit t is the voxelizer's boundary of this very cell, not a sum of steps.
+    double expected = kInfinity;
+    for (int a = 0; a < 3; ++a) {
+      const double d = ray.direction[a];
+      if (d == 0) continue;
+      const double b = cellBoundary(g.bounds, g.dims, a, int64_t(cell.idx[a]) + (d > 0 ? 1 : 0));
+      expected = std::min(expected, (b - ray.origin[a]) / d);
+    }
+    ASSERT_EQ(cell.tExit, expected) << what << ": cell " << cell.idx[0] << " " << cell.idx[1] << " " << cell.idx[2];
+  }
   ASSERT_FALSE(visited.empty()) << what;
   std::set<std::array<int64_t, 3>> checked;
   for (const auto& v : visited)

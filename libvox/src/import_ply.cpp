@@ -1,6 +1,7 @@
 // PLY triangle meshes through OpenMesh 9 (read_mesh into a PolyMesh, then fan triangulation here).
 // Quirks relied on:
 // - MeshIO.hh must be included before the mesh kernel headers, or no reader gets registered.
+// - OpenMesh's PLY reader trusts its header (see checkPlyHeader).
 // - OpenMesh's importer drops faces with an invalid or repeated vertex index (it prints to omerr and goes on) and
 //   re-adds non-manifold faces with duplicated vertices, so every valid face survives. We compare the face count
 //   with the header's `element face N` to report dropped faces as a warning.
@@ -12,10 +13,14 @@
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 
+#include <algorithm>
+#include <charconv>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "vox/error.h"
 #include "vox/import.h"
@@ -28,20 +33,96 @@ struct DoubleTraits : OpenMesh::DefaultTraits {
 };
 using PlyMesh = OpenMesh::PolyMesh_ArrayKernelT<DoubleTraits>;
 
-// The face count in the PLY header, or -1 when the header cannot be read.
-long long headerFaceCount(const std::string& path) {
+// What the PLY header promises, checked before OpenMesh sees the file: OpenMesh 9 loops forever on a header
+// without `end_header` and trusts element counts, so a corrupt header could hang it or make it allocate without
+// bound. Counts are checked against the bytes that follow the header (each element needs a minimum number of
+// bytes), so OpenMesh's work stays proportional to the file size.
+struct PlyHeader {
+  long long faces = 0;
+};
+
+int plyTypeSize(std::string_view t) {
+  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
+  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
+  if (t == "int" || t == "uint" || t == "int32" || t == "uint32" || t == "float" || t == "float32") return 4;
+  if (t == "double" || t == "float64") return 8;
+  return 0;
+}
+
+PlyHeader checkPlyHeader(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  std::string line;
-  if (!std::getline(in, line) || line.rfind("ply", 0) != 0) return -1;
-  for (int guard = 0; guard < 10000 && std::getline(in, line); ++guard) {
+  if (!in) fail<InputError>(path, ": cannot open PLY file");
+  in.seekg(0, std::ios::end);
+  const long long fileSize = static_cast<long long>(in.tellg());
+  in.seekg(0);
+  constexpr long long kMaxHeader = 1 << 20;
+  std::string head(static_cast<size_t>(std::min(fileSize, kMaxHeader)), '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+
+  struct Element {
+    std::string name;
+    long long count = 0;
+    long long minBytes = 0;  // per element
+  };
+  std::vector<Element> elements;
+  bool ascii = false;
+  size_t pos = 0;
+  int lineNumber = 0;
+  for (;;) {
+    const size_t eol = head.find('\n', pos);
+    if (eol == std::string::npos) fail<InputError>(path, ": PLY header has no end_header line");
+    std::string line = head.substr(pos, eol - pos);
+    pos = eol + 1;
+    ++lineNumber;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
     std::istringstream words(line);
-    std::string a, b;
-    long long n = -1;
-    words >> a;
-    if (a == "end_header") break;
-    if (a == "element" && (words >> b >> n) && b == "face") return n;
+    std::vector<std::string> w;
+    for (std::string word; words >> word;) w.push_back(word);
+    auto bad = [&]() { fail<InputError>(path, ":", lineNumber, ": malformed PLY header line '", line, "'"); };
+    if (lineNumber == 1) {
+      if (w.size() != 1 || w[0] != "ply") fail<InputError>(path, ": not a PLY file (first line is not 'ply')");
+    } else if (lineNumber == 2) {
+      if (w.size() != 3 || w[0] != "format" ||
+          (w[1] != "ascii" && w[1] != "binary_little_endian" && w[1] != "binary_big_endian"))
+        bad();
+      ascii = w[1] == "ascii";
+    } else if (w.empty() || w[0] == "comment" || w[0] == "obj_info") {
+      continue;
+    } else if (w[0] == "end_header") {
+      break;
+    } else if (w[0] == "element") {
+      if (w.size() != 3) bad();
+      Element e{w[1], -1, 0};
+      const auto [end, ec] = std::from_chars(w[2].data(), w[2].data() + w[2].size(), e.count);
+      if (ec != std::errc() || end != w[2].data() + w[2].size() || e.count < 0) bad();
+      elements.push_back(e);
+    } else if (w[0] == "property") {
+      if (elements.empty()) bad();
+      long long bytes = 0;
+      if (w.size() == 5 && w[1] == "list" && plyTypeSize(w[2]) && plyTypeSize(w[3]))
+        bytes = ascii ? 2 : plyTypeSize(w[2]);
+      else if (w.size() == 3 && plyTypeSize(w[1]))
+        bytes = ascii ? 2 : plyTypeSize(w[1]);
+      else
+        bad();
+      elements.back().minBytes += bytes;
+    } else {
+      bad();
+    }
   }
-  return -1;
+  PlyHeader header;
+  bool hasVertices = false;
+  long double needed = 0;  // wide enough for count * bytes without overflow
+  for (const Element& e : elements) {
+    needed += static_cast<long double>(e.count) * static_cast<long double>(std::max(e.minBytes, 1LL));
+    if (e.name == "vertex") hasVertices = true;
+    if (e.name == "face") header.faces = e.count;
+  }
+  if (!hasVertices) fail<InputError>(path, ": PLY header has no vertex element");
+  // ASCII: the last value may end at end of file without a separator.
+  if (needed > static_cast<long double>(fileSize - static_cast<long long>(pos)) + 1)
+    fail<InputError>(path, ": PLY file is shorter than its header's element counts need (truncated?)");
+  return header;
 }
 
 // Mutes an OpenMesh stream for the lifetime of the guard, restoring its previous state.
@@ -64,8 +145,7 @@ class MuteStream {
 Scene importPly(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) fail<InputError>(path, ": cannot open PLY file");
-  const long long expectedFaces = headerFaceCount(path);
-  if (expectedFaces < 0) fail<InputError>(path, ": not a PLY file (no 'ply' header with an 'element face' line)");
+  const long long expectedFaces = checkPlyHeader(path).faces;
 
   PlyMesh mesh;
   bool ok = false;

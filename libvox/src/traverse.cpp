@@ -172,7 +172,7 @@ Hit traceRay(const Accel& accel, const Ray& ray, TraceStats* stats) {
       }
       // A hit may lie beyond this cell (a primitive spanning cells): it is kept, and accepted only once the walk
       // has passed every cell that could hold a nearer one.
-      if (best.valid() && best.t <= cell.tExit) break;
+      if (best.valid() && best.t + walker.hitSlack(best.t) < cell.tExit - cell.exitSlack) break;
     }
   }
   if (stats) *stats += st;

@@ -477,6 +477,7 @@ struct Square {
 
 struct ExposedSurface {
   std::vector<Vec3> positions;
+  std::vector<uint8_t> split;  // per vertex: its lattice point has several vertices (several sheets of surface)
   std::vector<Square> squares;
 };
 
@@ -524,6 +525,7 @@ ExposedSurface buildExposed(const Voxels& vox, const Lattice& lat) {
 
   ExposedSurface out;
   out.positions.resize(vertexBase[nWork]);
+  out.split.resize(vertexBase[nWork]);
   std::vector<std::vector<Square>> perBrick(nWork);
 
   // Pass 2: vertex positions, and the exposed squares of each brick's voxels with their vertex ids.
@@ -539,7 +541,10 @@ ExposedSurface buildExposed(const Voxels& vox, const Lattice& lat) {
         const uint32_t end = l + 1 < 512 ? firstLocal[w][l + 1] : uint32_t(vertexBase[w + 1] - vertexBase[w]);
         if (first == end) continue;
         const Vec3 p = lat.point(uint64_t(ox + (l & 7)), uint64_t(oy + ((l >> 3) & 7)), uint64_t(oz + (l >> 6)));
-        for (uint32_t c = first; c < end; ++c) out.positions[vertexBase[w] + c] = p;
+        for (uint32_t c = first; c < end; ++c) {
+          out.positions[vertexBase[w] + c] = p;
+          out.split[vertexBase[w] + c] = end - first > 1;
+        }
       }
       auto occIt = set.index.find(workKeys[w]);
       if (occIt == set.index.end()) continue;
@@ -732,9 +737,13 @@ VoxelMesh mergedMesh(ExposedSurface&& surface, const std::array<uint32_t, 3>& di
   std::vector<Square>().swap(sq);
 
   // Keep the vertices that are a corner of some rectangle; the others lie inside a rectangle or straight along
-  // the sides of all their rectangles, and dropping them leaves no T-junction.
+  // the sides of all their rectangles (then they have two faces), and dropping them leaves no T-junction. Split
+  // lattice points stay: where two sheets run along the same lattice line (two voxels meeting along a row of
+  // edges), dropping their vertices would give both sheets the same long edge, with four faces.
   const size_t nv = surface.positions.size();
   std::vector<std::atomic<uint8_t>> keep(nv);
+  for (size_t v = 0; v < nv; ++v)
+    if (surface.split[v]) keep[v].store(1, std::memory_order_relaxed);
   tbb::parallel_for(size_t(0), outs.size(), [&](size_t pi) {
     const PlaneOut& po = outs[pi];
     for (size_t k = 0; k < po.verts.size(); ++k)

@@ -9,7 +9,7 @@ namespace vox {
 AccelKind parseAccel(const std::string& name) {
   if (name == "grid") return AccelKind::Grid;
   if (name == "none") return AccelKind::None;
-  fail<InputError>("unknown acceleration '", name, "' (expected grid or none)");
+  fail<UsageError>("unknown acceleration '", name, "' (expected grid or none)");
 }
 
 uint32_t Accel::lookupSlow(uint32_t i, uint32_t j, uint32_t k) const {

@@ -326,6 +326,7 @@ void writeGltf(const std::string& temp, const std::string& path, const VoxelMesh
   model.asset.version = "2.0";
   model.asset.generator = std::string("libvox ") + versionString() + " vox-export";
   tinygltf::Scene scene;
+  scene.name = "voxels";  // also keeps an empty scene a JSON object rather than null
   if (mesh.faceCount() > 0) {
     std::vector<float> pos, col;
     std::vector<uint32_t> idx(mesh.faceVertices.size());

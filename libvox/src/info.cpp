@@ -15,7 +15,11 @@ std::string num(double x) {
   return buf;
 }
 
-std::string vec(const Vec3& v) { return "[" + num(v.x) + ", " + num(v.y) + ", " + num(v.z) + "]"; }
+std::string vec(const Vec3& v) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "[%.17g, %.17g, %.17g]", v.x, v.y, v.z);
+  return buf;
+}
 
 std::string jsonString(const std::string& s) {
   std::string out = "\"";

@@ -62,3 +62,15 @@ bool sphereBoxFiltered(const Sphere& s, const Box& box, bool* usedFallback) {
 namespace vox {
 bool sphereBoxExact(const Sphere& s, const Box& box) { return sphereBoxFiltered(s, box, nullptr); }
 }  // namespace vox
+
+namespace vox {
+// `sat` for spheres: the exact method's interval stage alone; where intervals cannot decide, the cell is taken.
+bool sphereBoxSat(const Sphere& s, const Box& box) {
+  CGAL::Protect_FPU_rounding<true> guard;
+  try {
+    return sphereSurfaceMeetsBox<CGAL::Interval_nt<false>>(s, box);
+  } catch (const CGAL::Uncertain_conversion_exception&) {
+    return true;
+  }
+}
+}  // namespace vox

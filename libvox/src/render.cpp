@@ -343,8 +343,9 @@ Image depthToGrey(const Image& depth) {
   }
   for (float& v : grey.pixels) {
     if (v <= 0) continue;
-    const float f = hi > lo ? (v - lo) / (hi - lo) : 0.0f;
-    v = 1.0f - 0.85f * f;
+    // Linear in inverse depth, so that a floor running to the horizon does not wash out everything near.
+    const double f = hi > lo ? (1.0 / v - 1.0 / hi) / (1.0 / lo - 1.0 / hi) : 1.0;
+    v = float(0.15 + 0.85 * f);
   }
   return grey;
 }

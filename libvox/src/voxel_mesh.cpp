@@ -398,13 +398,14 @@ BrickSet buildBricks(const Voxels& vox, const std::array<uint32_t, 3>& dims) {
 
 // Occupancy of the cells around one brick: local cell coordinates -kPadLo .. kBrick + kPadHi - 1.
 struct Pad {
-  std::array<uint8_t, kPad * kPad * kPad> cells;
+  // rows[z][y] bit (x + kPadLo): cell (x, y, z) in local cell coordinates, each from -kPadLo to kBrick + kPadHi - 1.
+  std::array<std::array<uint16_t, kPad>, kPad> rows;
 
-  static int index(int x, int y, int z) { return (x + kPadLo) + kPad * ((y + kPadLo) + kPad * (z + kPadLo)); }
-  bool at(int x, int y, int z) const { return cells[index(x, y, z)] != 0; }
+  bool at(int x, int y, int z) const { return (rows[z + kPadLo][y + kPadLo] >> (x + kPadLo)) & 1; }
+  uint32_t row(int y, int z) const { return rows[z + kPadLo][y + kPadLo]; }
 
   void fill(const BrickSet& set, int64_t bx, int64_t by, int64_t bz) {
-    cells.fill(0);
+    for (auto& r : rows) r.fill(0);
     for (int dz = -1; dz <= 1; ++dz)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
@@ -416,18 +417,27 @@ struct Pad {
             if (d > 0) return {0, kPadHi};
             return {0, kBrick};
           };
-          const auto rx = range(dx), ry = range(dy), rz = range(dz);
+          const auto ry = range(dy), rz = range(dz);
           for (int z = rz[0]; z < rz[1]; ++z) {
             const uint64_t layer = b->mask[z];
             if (!layer) continue;
             for (int y = ry[0]; y < ry[1]; ++y) {
-              const uint64_t row = (layer >> (8 * y)) & 0xFF;
-              if (!row) continue;
-              for (int x = rx[0]; x < rx[1]; ++x)
-                cells[index(x + dx * kBrick, y + dy * kBrick, z + dz * kBrick)] = uint8_t((row >> x) & 1);
+              const uint32_t bits = uint32_t((layer >> (8 * y)) & 0xFF);
+              if (!bits) continue;
+              // Bit x of the neighbour's row is local x + dx*kBrick, stored at bit x + dx*kBrick + kPadLo.
+              const int shift = dx * kBrick + kPadLo;
+              const uint32_t placed = shift >= 0 ? bits << shift : bits >> -shift;
+              rows[z + dz * kBrick + kPadLo][y + dy * kBrick + kPadLo] |= uint16_t(placed & ((1u << kPad) - 1));
             }
           }
         }
+  }
+
+  // The eight octant bits around lattice point (x,y,z): octant dx | dy<<1 | dz<<2 is cell (x-1+dx, y-1+dy, z-1+dz).
+  int octants(int x, int y, int z) const {
+    const int s = x - 1 + kPadLo;
+    return int((row(y - 1, z - 1) >> s) & 3) | int(((row(y, z - 1) >> s) & 3) << 2) |
+           int(((row(y - 1, z) >> s) & 3) << 4) | int(((row(y, z) >> s) & 3) << 6);
   }
 
   // Decision for checkerboard edge e at lattice point (x,y,z) (local lattice coordinates, 0..kBrick): join the two
@@ -449,14 +459,12 @@ struct Pad {
       if (diag00) return cell(layer, 0, 0) && cell(layer, 1, 1) && (cell(layer, 1, 0) || cell(layer, 0, 1));
       return cell(layer, 1, 0) && cell(layer, 0, 1) && (cell(layer, 0, 0) || cell(layer, 1, 1));
     };
-    return false && connected(m - 1) && connected(m + 1);
+    return connected(m - 1) && connected(m + 1);
   }
 
   // Configuration of lattice point (x,y,z), local lattice coordinates in [0, kBrick].
   uint16_t config(int x, int y, int z, const PointTables& t) const {
-    int occ = 0;
-    for (int o = 0; o < 8; ++o)
-      if (at(x - 1 + (o & 1), y - 1 + ((o >> 1) & 1), z - 1 + ((o >> 2) & 1))) occ |= 1 << o;
+    const int occ = octants(x, y, z);
     int dec = 0;
     for (uint8_t ce = t.checkerEdges[occ]; ce; ce &= uint8_t(ce - 1)) {
       const int e = std::countr_zero(ce);
@@ -513,10 +521,18 @@ ExposedSurface buildExposed(const Voxels& vox, const Lattice& lat) {
       const auto bc = brickCoords(workKeys[w]);
       pad.fill(set, bc[0], bc[1], bc[2]);
       uint32_t running = 0;
-      for (int l = 0; l < 512; ++l) {
-        firstLocal[w][l] = uint16_t(running);
-        running += tables.cycleCount[pad.config(l & 7, (l >> 3) & 7, l >> 6, tables)];
-      }
+      for (int z = 0; z < kBrick; ++z)
+        for (int y = 0; y < kBrick; ++y) {
+          // A row of lattice points without any voxel around it has no vertex.
+          const bool empty = (pad.row(y - 1, z - 1) | pad.row(y, z - 1) | pad.row(y - 1, z) | pad.row(y, z)) == 0;
+          for (int x = 0; x < kBrick; ++x) {
+            firstLocal[w][x + 8 * y + 64 * z] = uint16_t(running);
+            if (!empty) {
+              const int occ = pad.octants(x, y, z);
+              if (occ != 0 && occ != 255) running += tables.cycleCount[pad.config(x, y, z, tables)];
+            }
+          }
+        }
       vertexBase[w + 1] = running;
     }
   });
@@ -646,10 +662,18 @@ VoxelMesh mergedMesh(ExposedSurface&& surface, const std::array<uint32_t, 3>& di
   std::vector<uint32_t> planeStart(nPlanes + 1, 0);
   for (const Square& s : sq) ++planeStart[planeOf(s) + 1];
   for (size_t p = 0; p < nPlanes; ++p) planeStart[p + 1] += planeStart[p];
-  std::vector<uint32_t> order(sq.size());
+  // Within a plane, squares sorted by (v, u): a contiguous array of keys, so the greedy scan and its row lookups
+  // touch the squares themselves only to compare colours and read vertices.
+  struct Entry {
+    uint64_t key;  // v << 32 | u
+    uint32_t color;
+    uint32_t idx;
+  };
+  std::vector<Entry> order(sq.size());
   {
     std::vector<uint32_t> cursor(planeStart.begin(), planeStart.end() - 1);
-    for (uint32_t i = 0; i < sq.size(); ++i) order[cursor[planeOf(sq[i])]++] = i;
+    for (uint32_t i = 0; i < sq.size(); ++i)
+      order[cursor[planeOf(sq[i])]++] = {(uint64_t(sq[i].v) << 32) | sq[i].u, sq[i].color, i};
   }
   std::vector<size_t> planes;
   for (size_t p = 0; p < nPlanes; ++p)
@@ -665,48 +689,32 @@ VoxelMesh mergedMesh(ExposedSurface&& surface, const std::array<uint32_t, 3>& di
   std::vector<PlaneOut> outs(planes.size());
   tbb::parallel_for(size_t(0), planes.size(), [&](size_t pi) {
     const size_t p = planes[pi];
-    const auto first = order.begin() + planeStart[p], last = order.begin() + planeStart[p + 1];
-    std::sort(first, last, [&](uint32_t x, uint32_t y) {
-      const Square &a = sq[x], &b = sq[y];
-      if (a.color != b.color) return a.color < b.color;
-      if (a.v != b.v) return a.v < b.v;
-      return a.u < b.u;
-    });
-    const size_t n = size_t(last - first);
-    const uint32_t* idx = &*first;
+    Entry* const e = order.data() + planeStart[p];
+    const size_t n = planeStart[p + 1] - planeStart[p];
+    std::sort(e, e + n, [](const Entry& x, const Entry& y) { return x.key < y.key; });
     std::vector<uint8_t> used(n, 0);
-    auto findSquare = [&](size_t from, uint32_t color, uint32_t v, uint32_t u) -> size_t {
-      size_t lo = from, hi = n;
-      while (lo < hi) {
-        const size_t mid = (lo + hi) / 2;
-        const Square& m = sq[idx[mid]];
-        const bool less = m.color != color ? m.color < color : (m.v != v ? m.v < v : m.u < u);
-        if (less)
-          lo = mid + 1;
-        else
-          hi = mid;
-      }
-      if (lo < n && sq[idx[lo]].color == color && sq[idx[lo]].v == v && sq[idx[lo]].u == u) return lo;
-      return n;
+    auto findSquare = [&](size_t from, uint64_t key) -> size_t {
+      const Entry* it = std::lower_bound(e + from, e + n, key, [](const Entry& x, uint64_t k) { return x.key < k; });
+      return it != e + n && it->key == key ? size_t(it - e) : n;
+    };
+    // Squares (i + k) continue the row of square i with the same colour, unused.
+    auto extends = [&](size_t j, uint64_t key, uint32_t color) {
+      return j < n && !used[j] && e[j].key == key && e[j].color == color;
     };
     PlaneOut& po = outs[pi];
     std::vector<size_t> rowStart;
     for (size_t i = 0; i < n; ++i) {
       if (used[i]) continue;
-      const Square& s0 = sq[idx[i]];
+      const uint32_t color = e[i].color;
+      const bool positive = sq[e[i].idx].positive;
       uint32_t w = 1;
-      while (i + w < n && !used[i + w] && sq[idx[i + w]].color == s0.color && sq[idx[i + w]].v == s0.v &&
-             sq[idx[i + w]].u == s0.u + w)
-        ++w;
+      while (extends(i + w, e[i].key + w, color)) ++w;
       rowStart.assign(1, i);
       for (;;) {
-        const size_t j = findSquare(i, s0.color, s0.v + uint32_t(rowStart.size()), s0.u);
-        if (j == n || j + w > n) break;
-        bool ok = true;
-        for (uint32_t k = 0; k < w && ok; ++k) {
-          const Square& t = sq[idx[j + k]];
-          ok = !used[j + k] && t.color == s0.color && t.v == s0.v + rowStart.size() && t.u == s0.u + k;
-        }
+        const uint64_t rowKey = e[i].key + (uint64_t(rowStart.size()) << 32);
+        const size_t j = findSquare(i, rowKey);
+        bool ok = j < n;
+        for (uint32_t k = 0; k < w && ok; ++k) ok = extends(j + k, rowKey + k, color);
         if (!ok) break;
         rowStart.push_back(j);
       }
@@ -715,7 +723,7 @@ VoxelMesh mergedMesh(ExposedSurface&& surface, const std::array<uint32_t, 3>& di
       // Boundary lattice points counter-clockwise about +axis in (u, v): along v = 0, u = w, v = h, u = 0.
       auto vertexAt = [&](uint32_t du, uint32_t dv) {
         const uint32_t cu = std::min(du, w - 1), cv = std::min(dv, h - 1);
-        const Square& s = sq[idx[rowStart[cv] + cu]];
+        const Square& s = sq[e[rowStart[cv] + cu].idx];
         const int k = (du - cu) + 2 * (dv - cv);  // corner (du-cu, dv-cv): 0 -> 00, 1 -> 10, 3 -> 11, 2 -> 01
         static constexpr int kCornerIndex[4] = {0, 1, 3, 2};
         return s.vid[kCornerIndex[k]];
@@ -725,13 +733,13 @@ VoxelMesh mergedMesh(ExposedSurface&& surface, const std::array<uint32_t, 3>& di
       for (uint32_t v = 0; v < h; ++v) po.verts.push_back(vertexAt(w, v)), po.corner.push_back(v == 0);
       for (uint32_t u = w; u > 0; --u) po.verts.push_back(vertexAt(u, h)), po.corner.push_back(u == w);
       for (uint32_t v = h; v > 0; --v) po.verts.push_back(vertexAt(0, v)), po.corner.push_back(v == h);
-      if (!s0.positive) {
+      if (!positive) {
         // Reverse the cycle but keep the first vertex first.
         std::reverse(po.verts.begin() + ptrdiff_t(begin) + 1, po.verts.end());
         std::reverse(po.corner.begin() + ptrdiff_t(begin) + 1, po.corner.end());
       }
       po.start.push_back(uint32_t(po.verts.size()));
-      po.colors.push_back(s0.color);
+      po.colors.push_back(color);
     }
   });
   std::vector<Square>().swap(sq);

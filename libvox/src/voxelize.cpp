@@ -319,7 +319,7 @@ Grid voxelizeScene(const Scene& scene, const VoxelizeOptions& options, VoxelizeS
       filter.prepare(qMax);
     }
     const bool sat = options.method == OverlapMethod::Sat;
-    if (!sat && isDegenerate(t)) ++local.degenerate;
+    if (isDegenerate(t)) ++local.degenerate;
     const PlaneSweep sweep(filter, t, primBox);
     const int a = sweep.axis, b = (a + 1) % 3, c = (a + 2) % 3;
     int64_t idx[3];
@@ -343,19 +343,14 @@ Grid voxelizeScene(const Scene& scene, const VoxelizeOptions& options, VoxelizeS
         for (idx[a] = from; idx[a] <= to; ++idx[a]) {
           lo[a] = boundary[a][idx[a]];
           hi[a] = boundary[a][idx[a] + 1];
-          bool hit;
-          if (sat) {
-            hit = triangleBoxSat(t, Box{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}});
-          } else {
-            // Exact: the filter decides; CGAL only where it cannot.
-            rel[0][a] = lo[a] - filter.origin[a];
-            rel[1][a] = hi[a] - filter.origin[a];
-            const FilterResult r = filter.test(lo, hi, rel);
-            hit = r == FilterResult::Overlap;
-            if (r == FilterResult::Unknown) {
-              ++local.fallbacks;
-              hit = triangleBoxExact(t, Box{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}});
-            }
+          rel[0][a] = lo[a] - filter.origin[a];
+          rel[1][a] = hi[a] - filter.origin[a];
+          const FilterResult r = filter.test(lo, hi, rel);
+          bool hit = r == FilterResult::Overlap;
+          if (r == FilterResult::Unknown) {
+            // sat takes undecided contacts; exact asks CGAL.
+            ++local.fallbacks;
+            hit = sat || triangleBoxExact(t, Box{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}});
           }
           if (hit) emit(idx[0], idx[1], idx[2]);
         }

@@ -16,7 +16,7 @@ namespace vox {
 
 // `Grid` walks the cells; `None` tests every primitive for every ray (brute force, the reference for tests).
 enum class AccelKind : uint8_t { Grid, None };
-// Throws InputError for a name other than "grid" or "none".
+// Throws UsageError for a name other than "grid" or "none".
 AccelKind parseAccel(const std::string& name);
 
 inline constexpr uint32_t kEmptyCell = 0xffffffffu;

@@ -12,7 +12,9 @@ namespace vox {
 bool triangleBoxExact(const Triangle& t, const Box& box);
 bool sphereBoxExact(const Sphere& s, const Box& box);
 
-// sat: Akenine-Moller 2001 separating-axis test in double precision, and a floating-point sphere-box distance test.
+// sat: the separating-axis test of Akenine-Moller 2001 in double precision (13 axes, relative to the first vertex)
+// and the sphere test in interval arithmetic, with no exact fallback: where rounding cannot decide a contact, the
+// cell is taken. So sat never misses a cell the exact test takes; it may add a few at exact contacts.
 bool triangleBoxSat(const Triangle& t, const Box& box);
 bool sphereBoxSat(const Sphere& s, const Box& box);
 

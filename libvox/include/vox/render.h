@@ -56,7 +56,7 @@ Ray primaryRay(const Camera& camera, uint32_t width, uint32_t height, double px,
 // direction, casting no shadow). Throws UsageError for a zero size or sample count.
 Image traceImage(const Scene& scene, const Accel& accel, const RenderOptions& options, RenderStats* stats = nullptr);
 
-// The depth image as grey for 8-bit formats: near is bright (1), the farthest hit 0.15, nothing hit 0.
+// The depth image as grey for 8-bit formats, linear in 1/depth: the nearest hit 1, the farthest 0.15, nothing hit 0.
 Image depthToGrey(const Image& depth);
 
 // Heat colour of value / maxValue in [0, 1] (dark blue, through red, to white) for the count mode.

@@ -1,6 +1,9 @@
 // Tests for the scene importers (import_course.cpp, import_obj.cpp, import_gltf.cpp, import_ply.cpp,
 // load_scene.cpp): counts of the seed scenes, transforms against hand-computed values, and bad input.
+#include "vox/import.h"
+
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -11,11 +14,9 @@
 #include <functional>
 #include <set>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 #include "vox/error.h"
-#include "vox/import.h"
 
 namespace vox {
 namespace {
@@ -30,8 +31,8 @@ class TempDir {
  public:
   TempDir() {
     static std::atomic<int> counter{0};
-    path_ = fs::temp_directory_path() /
-            ("vox_import_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+    path_ =
+        fs::temp_directory_path() / ("vox_import_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
     fs::remove_all(path_);
     fs::create_directories(path_);
   }
@@ -290,12 +291,11 @@ TEST(ImportCourse, NonUniformScaleKeepsTheEllipsoid) {
 
 TEST(ImportCourse, PlaneTransformUsesInverseTranspose) {
   TempDir dir;
-  const std::string path = dir.write(
-      "planes.txt",
-      courseScene("Group { numObjects 2 MaterialIndex 0\n"
-                  "Transform { Translate 0 5 0 ZRotate 90 Plane { normal 2 0 0 offset 4 } }\n"
-                  "Transform { Scale 1 2 1 Plane { normal 0 1 1 offset 1 } }\n"
-                  "}\n"));
+  const std::string path =
+      dir.write("planes.txt", courseScene("Group { numObjects 2 MaterialIndex 0\n"
+                                          "Transform { Translate 0 5 0 ZRotate 90 Plane { normal 2 0 0 offset 4 } }\n"
+                                          "Transform { Scale 1 2 1 Plane { normal 0 1 1 offset 1 } }\n"
+                                          "}\n"));
   const Scene s = loadScene(path);
   ASSERT_EQ(s.planes.size(), 2u);
   // x = 2 turned to y = 2, then lifted by 5.
@@ -310,12 +310,13 @@ TEST(ImportCourse, PlaneTransformUsesInverseTranspose) {
 TEST(ImportCourse, RotateAndMatrixOps) {
   TempDir dir;
   // Matrix is multiplied on the left: M = Given * (Translate 1 0 0) -> scale x by 2 after translating.
-  const std::string path = dir.write(
-      "ops.txt", courseScene("Group { numObjects 2 MaterialIndex 0\n"
-                             "Transform { Rotate { 0 0 2 90 } Triangle { vertex0 1 0 0 vertex1 0 1 0 vertex2 0 0 1 } }\n"
-                             "Transform { Translate 1 0 0 Matrix { 2 0 0 0  0 1 0 0  0 0 1 0  0 0 0 1 }\n"
-                             "  Triangle { vertex0 1 0 0 vertex1 0 1 0 vertex2 0 0 1 } }\n"
-                             "}\n"));
+  const std::string path =
+      dir.write("ops.txt",
+                courseScene("Group { numObjects 2 MaterialIndex 0\n"
+                            "Transform { Rotate { 0 0 2 90 } Triangle { vertex0 1 0 0 vertex1 0 1 0 vertex2 0 0 1 } }\n"
+                            "Transform { Translate 1 0 0 Matrix { 2 0 0 0  0 1 0 0  0 0 1 0  0 0 0 1 }\n"
+                            "  Triangle { vertex0 1 0 0 vertex1 0 1 0 vertex2 0 0 1 } }\n"
+                            "}\n"));
   const Scene s = loadScene(path);
   ASSERT_EQ(s.triangles.size(), 2u);
   expectNear(s.triangles[0].v[0], {0, 1, 0}, 0);
@@ -338,10 +339,9 @@ TEST(ImportCourse, DefaultsWithoutLightsMaterialsOrBackground) {
 
 TEST(ImportCourse, ObjectBeforeMaterialIndexUsesMaterialZeroWithAWarning) {
   TempDir dir;
-  const std::string path = dir.write(
-      "nomat.txt", courseScene("Group { numObjects 2 Sphere { center 0 0 0 radius 1 }\n"
-                               "MaterialIndex 1 Sphere { center 0 0 0 radius 1 } }\n",
-                               2));
+  const std::string path = dir.write("nomat.txt", courseScene("Group { numObjects 2 Sphere { center 0 0 0 radius 1 }\n"
+                                                              "MaterialIndex 1 Sphere { center 0 0 0 radius 1 } }\n",
+                                                              2));
   const Scene s = loadScene(path);
   ASSERT_EQ(s.spheres.size(), 2u);
   EXPECT_EQ(s.spheres[0].material, 0u);
@@ -352,11 +352,10 @@ TEST(ImportCourse, ObjectBeforeMaterialIndexUsesMaterialZeroWithAWarning) {
 TEST(ImportCourse, LastTopLevelGroupWinsAndMaterialIndexIsGlobal) {
   TempDir dir;
   const std::string path = dir.write(
-      "twogroups.txt",
-      courseScene("Group { numObjects 1 MaterialIndex 1 Sphere { center 0 0 0 radius 1 } }\n"
-                  "Group { numObjects 2 Triangle { vertex0 0 0 0 vertex1 1 0 0 vertex2 0 1 0 }\n"
-                  "  Group { numObjects 1 MaterialIndex 2 Sphere { center 0 0 0 radius 2 } } }\n",
-                  3));
+      "twogroups.txt", courseScene("Group { numObjects 1 MaterialIndex 1 Sphere { center 0 0 0 radius 1 } }\n"
+                                   "Group { numObjects 2 Triangle { vertex0 0 0 0 vertex1 1 0 0 vertex2 0 1 0 }\n"
+                                   "  Group { numObjects 1 MaterialIndex 2 Sphere { center 0 0 0 radius 2 } } }\n",
+                                   3));
   const Scene s = loadScene(path);
   ASSERT_EQ(s.triangles.size(), 1u);
   ASSERT_EQ(s.spheres.size(), 1u);
@@ -380,23 +379,20 @@ TEST(ImportCourse, TriangleMeshMatchesTheObjImporter) {
 
 TEST(ImportCourse, MissingMeshFileNamesSceneLineAndMesh) {
   TempDir dir;
-  const std::string path =
-      dir.write("missing.txt", courseScene("Group { numObjects 1 MaterialIndex 0\n"
-                                           "TriangleMesh {\n obj_file nowhere.obj\n } }\n"));
+  const std::string path = dir.write("missing.txt", courseScene("Group { numObjects 1 MaterialIndex 0\n"
+                                                                "TriangleMesh {\n obj_file nowhere.obj\n } }\n"));
   expectInputError([&] { loadScene(path); }, {"missing.txt:8:", "nowhere.obj"});
 }
 
 TEST(ImportCourse, FaceIndexOutOfRangeNamesTheObjFileAndLine) {
   TempDir dir;
   dir.write("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n");
-  const std::string path =
-      dir.write("badmesh.txt", courseScene("Group { numObjects 1 MaterialIndex 0\n"
-                                           "TriangleMesh { obj_file bad.obj } }\n"));
+  const std::string path = dir.write("badmesh.txt", courseScene("Group { numObjects 1 MaterialIndex 0\n"
+                                                                "TriangleMesh { obj_file bad.obj } }\n"));
   expectInputError([&] { loadScene(path); }, {"bad.obj:5:", "out of range"});
   dir.write("zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n");
-  const std::string zero =
-      dir.write("zeromesh.txt", courseScene("Group { numObjects 1 MaterialIndex 0\n"
-                                            "TriangleMesh { obj_file zero.obj } }\n"));
+  const std::string zero = dir.write("zeromesh.txt", courseScene("Group { numObjects 1 MaterialIndex 0\n"
+                                                                 "TriangleMesh { obj_file zero.obj } }\n"));
   expectInputError([&] { loadScene(zero); }, {"zero.obj:4:"});
 }
 
@@ -404,15 +400,14 @@ TEST(ImportCourse, NanAndInfinityAreRefused) {
   TempDir dir;
   for (const char* bad : {"nan", "NaN", "inf", "-inf", "infinity", "1e999"}) {
     SCOPED_TRACE(bad);
-    const std::string path = dir.write(
-        "nan.txt", courseScene(std::string("Group { numObjects 1 MaterialIndex 0\nSphere { center 0 ") + bad +
-                               " 0 radius 1 } }\n"));
+    const std::string path =
+        dir.write("nan.txt", courseScene(std::string("Group { numObjects 1 MaterialIndex 0\nSphere { center 0 ") + bad +
+                                         " 0 radius 1 } }\n"));
     expectInputError([&] { loadScene(path); }, {"nan.txt:7:", "bad number"});
   }
   dir.write("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
-  const std::string mesh =
-      dir.write("nanmesh.txt", courseScene("Group { numObjects 1 MaterialIndex 0\n"
-                                           "TriangleMesh { obj_file nan.obj } }\n"));
+  const std::string mesh = dir.write("nanmesh.txt", courseScene("Group { numObjects 1 MaterialIndex 0\n"
+                                                                "TriangleMesh { obj_file nan.obj } }\n"));
   expectInputError([&] { loadScene(mesh); }, {"nan.obj:2:"});
 }
 
@@ -426,7 +421,8 @@ TEST(ImportCourse, MalformedScenesNameFileAndLine) {
       {"Grope { }\n", ":6: unknown keyword 'Grope'"},
       {"Group { numObjects 1 MaterialIndex 0\nSphere { center 0 0 0 radius 1.5x } }\n", ":7: bad number '1.5x'"},
       {"Group { numObjects -1 }\n", ":6: negative count"},
-      {"Group { numObjects 1 MaterialIndex 3\nSphere { center 0 0 0 radius 1 } }\n", ":6: MaterialIndex 3 out of range"},
+      {"Group { numObjects 1 MaterialIndex 3\nSphere { center 0 0 0 radius 1 } }\n",
+       ":6: MaterialIndex 3 out of range"},
       {"Group { numObjects 2 MaterialIndex 0\nSphere { center 0 0 0 radius 1 } }\n", ":7: Group ends after 1 of its 2"},
       {"Group { numObjects 1 MaterialIndex 0\nSphere { center 0 0 0 radius 1 \n", "unexpected end of file"},
       {"Group { numObjects 1 MaterialIndex 0\nSphere center 0 0 0 radius 1 } }\n", ":7: expected '{'"},
@@ -451,11 +447,21 @@ TEST(ImportCourse, TruncatedSeedSceneIsRefused) {
   const size_t groupStart = text.rfind("Group");
   ASSERT_NE(groupStart, std::string::npos);
   const size_t lastBrace = text.rfind('}');
-  for (size_t cut = groupStart + 6; cut < lastBrace; cut += 7) {
+  for (size_t cut = groupStart + 6; cut < lastBrace; cut += 11) {
     const std::string path = dir.write("cut.txt", text.substr(0, cut));
     dir.write("cube.obj", "v -1 -1 -1\nv 1 -1 -1\nv -1 1 -1\nf 1 2 3\n");
     expectInputError([&] { loadScene(path); }, {"cut.txt"});
   }
+}
+
+TEST(ImportCourse, AbsurdNestingIsAnErrorNotAStackOverflow) {
+  TempDir dir;
+  std::string body = "Group { numObjects 1 MaterialIndex 0\n";
+  for (int i = 0; i < 5000; ++i) body += "Transform { Translate 0 0 0\n";
+  body += "Sphere { center 0 0 0 radius 1 }\n";
+  for (int i = 0; i < 5000; ++i) body += "}\n";
+  const std::string path = dir.write("deep.txt", courseScene(body + "}\n"));
+  expectInputError([&] { loadScene(path); }, {"deep.txt:", "nested deeper"});
 }
 
 // ---------------------------------------------------------------- OBJ
@@ -634,7 +640,8 @@ struct TinyGltf {
     while (ib.size() % 4) ib.push_back('\0');
     dir.write("tiny.bin", bin + ib);
     const std::string json = R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
-      "nodes": [{"mesh": 0, )" + node + R"(}],
+      "nodes": [{"mesh": 0, )" +
+                             node + R"(}],
       "meshes": [{"name": "tri", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "mode": )" +
                              mode + R"(}]}],
       "buffers": [{"uri": "tiny.bin", "byteLength": )" +
@@ -692,6 +699,19 @@ TEST(ImportGltf, OutOfRangeAccessorAndIndexAreErrors) {
   TinyGltf hugeCount;
   hugeCount.accessorCount = "4611686018427387904";
   expectInputError([&] { loadScene(hugeCount.write(dir)); }, {"tiny.gltf"});
+}
+
+TEST(ImportGltf, SharedSubtreesCannotExplode) {
+  // 40 nodes, each listing the next twice: 2^40 paths if walked naively.
+  TempDir dir;
+  std::string nodes;
+  for (int i = 0; i < 40; ++i)
+    nodes +=
+        (i ? ", " : "") +
+        (i < 39 ? "{\"children\": [" + std::to_string(i + 1) + ", " + std::to_string(i + 1) + "]}" : std::string("{}"));
+  const std::string path =
+      dir.write("bomb.gltf", R"({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [)" + nodes + "]}");
+  expectInputError([&] { loadScene(path); }, {"bomb.gltf", "node visits"});
 }
 
 // ---------------------------------------------------------------- PLY and dispatch

@@ -23,8 +23,12 @@ TEST(Tradeoff, SmallModeInvariants) {
         EXPECT_EQ(row.refsMissed, 0u);
         EXPECT_EQ(row.cellsMissed, 0u);
       }
-      if (row.method == "exact") EXPECT_EQ(row.refsAdded + row.refsMissed, 0u);
-      if (row.method != "center") EXPECT_EQ(row.pixelsDiffering, 0u);
+      if (row.method == "exact") {
+        EXPECT_EQ(row.refsAdded + row.refsMissed, 0u);
+      }
+      if (row.method != "center") {
+        EXPECT_EQ(row.pixelsDiffering, 0u);
+      }
       EXPECT_GT(row.references, 0u);
       EXPECT_EQ(row.pixels, 24u * 24u);
       EXPECT_FALSE(bench::csvLine(row).empty());

@@ -249,7 +249,9 @@ TEST(Voxelize, SeedScenesWithTheirGridSizes) {
     for (size_t p = 0; p < seen.size(); ++p) ASSERT_TRUE(seen[p]) << "primitive " << p << " in no cell";
     const CellSet e = references(exact), b = references(bbox);
     for (const auto& ref : e) ASSERT_TRUE(b.count(ref));
-    if (c.dims == std::array<uint32_t, 3>{1, 1, 1}) EXPECT_EQ(exact.occupiedCount(), 1u);
+    if (c.dims == std::array<uint32_t, 3>{1, 1, 1}) {
+      EXPECT_EQ(exact.occupiedCount(), 1u);
+    }
   }
 }
 

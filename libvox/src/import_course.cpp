@@ -419,8 +419,7 @@ class CourseParser {
         const Token at = here();
         const long long k = readInteger();
         if (k < 0 || static_cast<size_t>(k) >= definedSoFar)
-          failAt(at, "materialIndex ", k, " does not name a material defined before it (", definedSoFar,
-                 " so far)");
+          failAt(at, "materialIndex ", k, " does not name a material defined before it (", definedSoFar, " so far)");
         indices.push_back(static_cast<uint32_t>(k));
       } else if (t.text == "octaves" && kind.text != "Checkerboard") {
         const Token at = here();
@@ -491,6 +490,15 @@ class CourseParser {
   }
 
   void parseObject(const Token& t, const Mat4& m, Primitives& out) {
+    // Objects nest through recursion; an absurd depth in an untrusted file must not overflow the stack.
+    constexpr int kMaxNesting = 1000;
+    if (nesting_ >= kMaxNesting) failAt(t, "objects nested deeper than ", kMaxNesting);
+    ++nesting_;
+    parseObjectBody(t, m, out);
+    --nesting_;
+  }
+
+  void parseObjectBody(const Token& t, const Mat4& m, Primitives& out) {
     if (t.text == "Group") {
       parseGroup(m, out);
     } else if (t.text == "Sphere") {
@@ -595,8 +603,7 @@ class CourseParser {
     auto it = meshes_.find(key);
     if (it == meshes_.end()) {
       std::error_code ec;
-      if (!std::filesystem::is_regular_file(file, ec))
-        failAt(name, "cannot open mesh file '", file.string(), "'");
+      if (!std::filesystem::is_regular_file(file, ec)) failAt(name, "cannot open mesh file '", file.string(), "'");
       it = meshes_.emplace(key, readStrictObj(file.string())).first;
     }
     const ObjMesh& mesh = it->second;
@@ -616,6 +623,7 @@ class CourseParser {
   std::optional<uint32_t> currentMaterial_;
   bool warnedNoMaterial_ = false;
   std::map<std::string, ObjMesh> meshes_;
+  int nesting_ = 0;
 };
 
 }  // namespace

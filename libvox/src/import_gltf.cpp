@@ -20,6 +20,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -145,6 +146,9 @@ class GltfReader {
     if (onPath[i]) failHere("node ", index, ": cycle in the node hierarchy");
     constexpr int kMaxDepth = 1000;
     if (depth > kMaxDepth) failHere("node ", index, ": hierarchy deeper than ", kMaxDepth);
+    // glTF requires strict trees, but a file that shares subtrees could make the walk exponential: cap it.
+    constexpr size_t kMaxVisits = 1'000'000;
+    if (++visits_ > kMaxVisits) failHere("node ", index, ": more than ", kMaxVisits, " node visits (shared subtrees?)");
     const tinygltf::Node& node = model_.nodes[i];
 
     Mat4 local;
@@ -153,13 +157,18 @@ class GltfReader {
     } else {
       if (!node.matrix.empty()) failHere("node ", index, ": matrix has ", node.matrix.size(), " numbers, not 16");
       Mat4 t, r, s;
-      if (node.translation.size() == 3) t = translation({node.translation[0], node.translation[1], node.translation[2]});
-      else if (!node.translation.empty()) failHere("node ", index, ": translation needs 3 numbers");
+      if (node.translation.size() == 3)
+        t = translation({node.translation[0], node.translation[1], node.translation[2]});
+      else if (!node.translation.empty())
+        failHere("node ", index, ": translation needs 3 numbers");
       if (node.rotation.size() == 4)
         r = fromQuaternion(node.rotation[0], node.rotation[1], node.rotation[2], node.rotation[3]);
-      else if (!node.rotation.empty()) failHere("node ", index, ": rotation needs 4 numbers");
-      if (node.scale.size() == 3) s = scaling({node.scale[0], node.scale[1], node.scale[2]});
-      else if (!node.scale.empty()) failHere("node ", index, ": scale needs 3 numbers");
+      else if (!node.rotation.empty())
+        failHere("node ", index, ": rotation needs 4 numbers");
+      if (node.scale.size() == 3)
+        s = scaling({node.scale[0], node.scale[1], node.scale[2]});
+      else if (!node.scale.empty())
+        failHere("node ", index, ": scale needs 3 numbers");
       local = t * r * s;  // glTF: T * R * S
     }
     const Mat4 world = parent * local;
@@ -194,7 +203,8 @@ class GltfReader {
     cam.center = transformPoint(world, {0, 0, 0});
     cam.direction = normalize(transformVector(world, {0, 0, -1}));
     cam.up = normalize(transformVector(world, {0, 1, 0}));
-    if (length(cam.direction) == 0 || length(cam.up) == 0) failHere("node ", nodeIndex, ": camera under a singular transform");
+    if (length(cam.direction) == 0 || length(cam.up) == 0)
+      failHere("node ", nodeIndex, ": camera under a singular transform");
     scene_.camera = cam;
   }
 
@@ -257,8 +267,7 @@ class GltfReader {
     View view{nullptr, stride, a.count};
     if (a.count == 0) return view;
     const uint64_t limit = std::numeric_limits<uint64_t>::max() / 2;
-    if (a.count > limit / stride)
-      failHere("accessor ", accessorIndex, ": count ", a.count, " is too large");
+    if (a.count > limit / stride) failHere("accessor ", accessorIndex, ": count ", a.count, " is too large");
     const uint64_t span = uint64_t(a.count - 1) * stride + elementSize;
     if (a.byteOffset > bv.byteLength || span > bv.byteLength - a.byteOffset)
       failHere("accessor ", accessorIndex, ": offset ", a.byteOffset, " + ", a.count, " elements of stride ", stride,
@@ -379,6 +388,7 @@ class GltfReader {
   Scene scene_;
   uint32_t defaultMaterial_ = 0;
   bool usesDefaultMaterial_ = false;
+  size_t visits_ = 0;
 };
 
 }  // namespace

@@ -12,7 +12,6 @@
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
-
 #include <algorithm>
 #include <cctype>
 #include <charconv>
@@ -162,7 +161,8 @@ long long checkPlyFile(const std::string& path) {
     size_t p = pos;
     for (const PlyElement& e : elements) {
       // Fixed-size elements are checked in one step so a large count costs nothing.
-      const bool fixed = std::none_of(e.properties.begin(), e.properties.end(), [](const PlyProperty& q) { return q.list; });
+      const bool fixed =
+          std::none_of(e.properties.begin(), e.properties.end(), [](const PlyProperty& q) { return q.list; });
       if (fixed) {
         size_t size = 0;
         for (const PlyProperty& q : e.properties) size += static_cast<size_t>(plyTypeSize(q.valueType));
@@ -235,7 +235,8 @@ Scene importPly(const std::string& path) {
       const auto& p = mesh.point(v);
       corners.push_back({p[0], p[1], p[2]});
     }
-    for (size_t k = 1; k + 1 < corners.size(); ++k) scene.triangles.push_back({{corners[0], corners[k], corners[k + 1]}, 0});
+    for (size_t k = 1; k + 1 < corners.size(); ++k)
+      scene.triangles.push_back({{corners[0], corners[k], corners[k + 1]}, 0});
   }
   if (static_cast<long long>(mesh.n_faces()) < expectedFaces) {
     scene.warnings.push_back(path + ": " + std::to_string(expectedFaces - static_cast<long long>(mesh.n_faces())) +

@@ -714,6 +714,16 @@ TEST(ImportGltf, SharedSubtreesCannotExplode) {
   expectInputError([&] { loadScene(path); }, {"bomb.gltf", "node visits"});
 }
 
+TEST(ImportGltf, DeepHierarchyIsAnErrorNotAStackOverflow) {
+  TempDir dir;
+  std::string nodes;
+  for (int i = 0; i < 3000; ++i)
+    nodes += (i ? ", " : "") + (i < 2999 ? "{\"children\": [" + std::to_string(i + 1) + "]}" : std::string("{}"));
+  const std::string path =
+      dir.write("deep.gltf", R"({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [)" + nodes + "]}");
+  expectInputError([&] { loadScene(path); }, {"deep.gltf", "deeper than"});
+}
+
 // ---------------------------------------------------------------- PLY and dispatch
 
 TEST(ImportPly, StanfordBunnyMatchesItsObjConversion) {

@@ -491,7 +491,7 @@ class CourseParser {
 
   void parseObject(const Token& t, const Mat4& m, Primitives& out) {
     // Objects nest through recursion; an absurd depth in an untrusted file must not overflow the stack.
-    constexpr int kMaxNesting = 1000;
+    constexpr int kMaxNesting = 256;
     if (nesting_ >= kMaxNesting) failAt(t, "objects nested deeper than ", kMaxNesting);
     ++nesting_;
     parseObjectBody(t, m, out);

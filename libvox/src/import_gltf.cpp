@@ -144,7 +144,7 @@ class GltfReader {
       failHere("node ", index, " does not exist (", model_.nodes.size(), " nodes)");
     const size_t i = static_cast<size_t>(index);
     if (onPath[i]) failHere("node ", index, ": cycle in the node hierarchy");
-    constexpr int kMaxDepth = 1000;
+    constexpr int kMaxDepth = 256;  // recursion; frames are large under sanitizers
     if (depth > kMaxDepth) failHere("node ", index, ": hierarchy deeper than ", kMaxDepth);
     // glTF requires strict trees, but a file that shares subtrees could make the walk exponential: cap it.
     constexpr size_t kMaxVisits = 1'000'000;

@@ -4,6 +4,7 @@
 # Usage: export_cli.sh BUILD_DIR SOURCE_DIR
 set -u
 build=$1
+src=$2
 export_tool=$build/vox-export
 voxelize=$build/vox-voxelize
 [ -x "$export_tool" ] || { echo "missing $export_tool"; exit 1; }
@@ -24,32 +25,13 @@ expect_code() {  # expect_code CODE DESCRIPTION COMMAND...
 expect_clean() { local left; left=$(find "$1" -maxdepth 1 -name '.*tmp*' | head -1); [ -z "$left" ] || fail "left behind: $left"; }
 
 # Two unit cubes apart and an L of triangles: small, with holes between them.
-cat >"$tmp/scene.obj" <<'OBJ'
-v 0 0 0
-v 1 0 0
-v 1 1 0
-v 0 1 0
-v 0 0 1
-v 1 0 1
-v 1 1 1
-v 0 1 1
-f 1 3 2
-f 1 4 3
-f 5 6 7
-f 5 7 8
-f 1 2 6
-f 1 6 5
-f 2 3 7
-f 2 7 6
-f 3 4 8
-f 3 8 7
-f 4 1 5
-f 4 5 8
+{ cat "$src/tests/data/unit_cube.obj"; cat <<'OBJ'
 v 2 0 0
 v 3 0 0
 v 3 2 1
 f 9 10 11
 OBJ
+} >"$tmp/scene.obj"
 expect_code 0 "voxelize" "$voxelize" "$tmp/scene.obj" -o "$tmp/g.vgrid" --grid 12 8 4 --quiet
 
 for faces in all exposed merged; do

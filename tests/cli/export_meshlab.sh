@@ -6,6 +6,7 @@
 # Usage: export_meshlab.sh BUILD_DIR SOURCE_DIR
 set -u
 build=$1
+src=$2
 if ! command -v meshlabserver >/dev/null || ! command -v xvfb-run >/dev/null; then
   echo "SKIP: meshlabserver or xvfb-run not installed"
   exit 0
@@ -17,32 +18,13 @@ failures=0
 fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 
 # A cube and a tilted triangle crossing near it: voxels meeting along edges and at corners.
-cat >"$tmp/scene.obj" <<'OBJ'
-v 0 0 0
-v 1 0 0
-v 1 1 0
-v 0 1 0
-v 0 0 1
-v 1 0 1
-v 1 1 1
-v 0 1 1
-f 1 3 2
-f 1 4 3
-f 5 6 7
-f 5 7 8
-f 1 2 6
-f 1 6 5
-f 2 3 7
-f 2 7 6
-f 3 4 8
-f 3 8 7
-f 4 1 5
-f 4 5 8
+{ cat "$src/tests/data/unit_cube.obj"; cat <<'OBJ'
 v 1.3 -0.2 0.1
 v 2.4 0.9 1.7
 v 1.1 1.6 0.4
 f 9 10 11
 OBJ
+} >"$tmp/scene.obj"
 "$build/vox-voxelize" "$tmp/scene.obj" -o "$tmp/g.vgrid" --grid 14 10 10 --quiet || { echo "FAIL: voxelize"; exit 1; }
 cat >"$tmp/topo.mlx" <<'MLX'
 <!DOCTYPE FilterScript>

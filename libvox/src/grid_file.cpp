@@ -112,7 +112,7 @@ class ByteReader {
   std::vector<T> getArray(const char* what) {
     const uint64_t n = getCount(sizeof(T), what);
     std::vector<T> values(n);
-    std::memcpy(values.data(), data_.data() + pos_, n * sizeof(T));
+    if (n > 0) std::memcpy(values.data(), data_.data() + pos_, n * sizeof(T));  // data() may be null when empty
     pos_ += n * sizeof(T);
     return values;
   }

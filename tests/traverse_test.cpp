@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <random>
+#include <optional>
 #include <set>
 
 #include "test_util.h"
@@ -532,20 +533,25 @@ bool rayMeetsBox(const Ray& ray, const Box& box) {
 }
 }  // namespace exact
 
-void expectExactCoverage(const Grid& g, const Ray& ray, const std::string& what) {
-  GridWalker walker(g.bounds, g.dims, ray);
+// With `sparse`, the walk of traceRay (which skips empty blocks of the two-level table) is checked instead, and only
+// cells of non-empty blocks must be visited.
+void expectExactCoverage(const Grid& g, const Ray& ray, const std::string& what, const Accel* sparse = nullptr) {
+  std::optional<GridWalker> walkerStore;
+  if (sparse) walkerStore.emplace(*sparse, ray);
+  else walkerStore.emplace(g.bounds, g.dims, ray);
+  GridWalker& walker = *walkerStore;
   std::set<std::array<int64_t, 3>> visited;
   WalkCell cell;
   while (walker.next(cell)) {
     visited.insert({cell.idx[0], cell.idx[1], cell.idx[2]});
     if (cell.extra) continue;
-    // The exit t is the voxelizer's boundary of this very cell, not a sum of steps.
+    // The exit t is computed from the voxelizer's boundary of this very cell, not a sum of steps.
     double expected = kInfinity;
     for (int a = 0; a < 3; ++a) {
       const double d = ray.direction[a];
       if (d == 0) continue;
       const double b = cellBoundary(g.bounds, g.dims, a, int64_t(cell.idx[a]) + (d > 0 ? 1 : 0));
-      expected = std::min(expected, (b - ray.origin[a]) / d);
+      expected = std::min(expected, GridWalker::crossing(b, ray.origin[a], d));
     }
     ASSERT_EQ(cell.tExit, expected) << what << ": cell " << cell.idx[0] << " " << cell.idx[1] << " " << cell.idx[2];
   }
@@ -559,6 +565,7 @@ void expectExactCoverage(const Grid& g, const Ray& ray, const std::string& what)
           bool in = true;
           for (int a = 0; a < 3; ++a) in &= c[a] >= 0 && c[a] < int64_t(g.dims[a]);
           if (!in || visited.count(c) || !checked.insert(c).second) continue;
+          if (sparse && sparse->blockEmpty(uint32_t(c[0]), uint32_t(c[1]), uint32_t(c[2]))) continue;
           const Box box = cellBox(g, uint32_t(c[0]), uint32_t(c[1]), uint32_t(c[2]));
           // A ray lying in a cell face (zero component, origin on the boundary) meets both cells of the face only
           // on the face itself; one of them suffices, since a primitive met there is in both.
@@ -569,7 +576,11 @@ void expectExactCoverage(const Grid& g, const Ray& ray, const std::string& what)
               std::array<int64_t, 3> n = c;
               n[a] += side;
               const double face = side < 0 ? box.lo[a] : box.hi[a];
-              inVisitedFace |= ray.origin[a] == face && visited.count(n) > 0;
+              // With skipping, the other cell may lie in an empty block: then no primitive meets the face there.
+              const bool nIn = n[a] >= 0 && n[a] < int64_t(g.dims[a]);
+              const bool nSkipped =
+                  sparse && nIn && sparse->blockEmpty(uint32_t(n[0]), uint32_t(n[1]), uint32_t(n[2]));
+              inVisitedFace |= ray.origin[a] == face && (visited.count(n) > 0 || nSkipped);
             }
           }
           if (inVisitedFace) continue;
@@ -607,6 +618,19 @@ TEST(WalkRobustness, ExactCoverageThroughRoundedCorners) {
     list.push_back(Ray{a, b - a});
   }
   for (const Ray& ray : list) expectExactCoverage(g, ray, "ray " + std::to_string(rays++));
+
+  // The same rays through a grid where most 4x4x4 blocks are empty: the walk that jumps over empty blocks must still
+  // visit every cell of the other blocks that the exact ray meets (it fails when the jump ignores the block's edges
+  // and corners or lands on the exit boundary itself).
+  Accel sparse;
+  sparse.grid = &g;
+  sparse.blockShift = 2;
+  for (int a = 0; a < 3; ++a) sparse.blockDims[a] = (g.dims[a] + 3) >> 2;
+  sparse.blockSlot.resize(size_t(sparse.blockDims[0]) * sparse.blockDims[1] * sparse.blockDims[2]);
+  for (uint32_t& slot : sparse.blockSlot) slot = rng() % 5 == 0 ? 0 : kEmptyCell;  // only emptiness matters here
+  sparse.boundaries = makeCellBoundaries(g.bounds, g.dims);
+  rays = 0;
+  for (const Ray& ray : list) expectExactCoverage(g, ray, "sparse ray " + std::to_string(rays++), &sparse);
 }
 
 TEST(GridVsBruteForce, NearCoincidentHitsOnBothSidesOfABoundary) {

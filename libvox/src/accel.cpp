@@ -1,6 +1,8 @@
 #include "vox/accel.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 #include "vox/error.h"
 
@@ -18,6 +20,24 @@ uint32_t Accel::lookupSlow(uint32_t i, uint32_t j, uint32_t k) const {
   if (c >= 0) return uint32_t(c);
   if (std::binary_search(grid->solidKeys.begin(), grid->solidKeys.end(), key)) return kSolidCell;
   return kEmptyCell;
+}
+
+CellBoundaries makeCellBoundaries(const Box& bounds, const std::array<uint32_t, 3>& dims) {
+  CellBoundaries cb;
+  cb.dims = dims;
+  double minCell = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    cb.b[a].resize(size_t(dims[a]) + 1);
+    for (int64_t i = 0; i <= int64_t(dims[a]); ++i) cb.b[a][size_t(i)] = cellBoundary(bounds, dims, a, i);
+    const double lo = cb.b[a].front(), hi = cb.b[a].back();
+    const double n = dims[a] == 0 ? 1.0 : double(dims[a]);
+    cb.cellSize[a] = (hi - lo) / n;
+    cb.cellsPerUnit[a] = hi > lo ? n / (hi - lo) : 0;
+    cb.magnitude[a] = std::max(std::fabs(lo), std::fabs(hi));
+    if (cb.cellSize[a] > 0) minCell = std::min(minCell, cb.cellSize[a]);
+  }
+  cb.minCell = std::isfinite(minCell) ? minCell : 0;
+  return cb;
 }
 
 namespace {
@@ -101,6 +121,7 @@ Accel buildAccel(const Scene& scene, const Grid& grid, AccelKind kind) {
   if (grid.occupiedCount() >= kSolidCell)
     fail<LimitError>("grid has ", grid.occupiedCount(), " occupied cells; at most 2^32 - 2 can be traced");
   buildTables(accel, grid);
+  accel.boundaries = makeCellBoundaries(grid.bounds, grid.dims);
   return accel;
 }
 

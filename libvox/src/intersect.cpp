@@ -6,7 +6,10 @@
 
 namespace vox {
 
-TriangleData prepareTriangle(const Triangle& t) { return {t.v[0], t.v[1] - t.v[0], t.v[2] - t.v[0]}; }
+TriangleData prepareTriangle(const Triangle& t) {
+  const Vec3 e1 = t.v[1] - t.v[0], e2 = t.v[2] - t.v[0];
+  return {t.v[0], e1, e2, cross(e1, e2)};
+}
 
 SphereData prepareSphere(const Sphere& s) {
   SphereData d;
@@ -20,19 +23,24 @@ SphereData prepareSphere(const Sphere& s) {
   return d;
 }
 
-// Moller & Trumbore 1997, in double precision, closed barycentric test.
+// Cramer's rule on o + t d = v0 + u e1 + v e2 (the Moller-Trumbore system) with the normal n = e1 x e2
+// precomputed: with s = o - v0 and c = s x d, det = -d.n, u = e2.c / det, v = -e1.c / det, t = s.n / det. The closed
+// barycentric test compares the numerators with det (sign-aware) instead of dividing first, so the one division
+// is paid by candidates that pass it; a miss costs 15 multiplications and no division.
 bool intersectTriangle(const TriangleData& tri, const Ray& ray, double& t) {
-  const Vec3 p = cross(ray.direction, tri.e2);
-  const double det = dot(tri.e1, p);
+  const Vec3& d = ray.direction;
+  const double det = -dot(d, tri.n);
   if (det == 0 || !std::isfinite(det)) return false;
-  const double invDet = 1.0 / det;
   const Vec3 s = ray.origin - tri.v0;
-  const double u = dot(s, p) * invDet;
-  if (!(u >= 0 && u <= 1)) return false;
-  const Vec3 q = cross(s, tri.e1);
-  const double v = dot(ray.direction, q) * invDet;
-  if (!(v >= 0 && u + v <= 1)) return false;
-  const double hitT = dot(tri.e2, q) * invDet;
+  const Vec3 c = cross(s, d);
+  const double uu = dot(tri.e2, c);
+  const double vv = -dot(tri.e1, c);
+  if (det > 0) {
+    if (!(uu >= 0 && vv >= 0 && uu + vv <= det)) return false;
+  } else {
+    if (!(uu <= 0 && vv <= 0 && uu + vv >= det)) return false;
+  }
+  const double hitT = dot(s, tri.n) / det;
   if (!(hitT >= ray.tMin && hitT <= ray.tMax)) return false;
   t = hitT;
   return true;

@@ -12,68 +12,70 @@ constexpr double kEps = std::numeric_limits<double>::epsilon();
 // visit the cells across it. Costs an extra cell visit about once per million crossings.
 constexpr double kCellSlack = 1e-6;
 
-// Largest i in [0, n-1] with b(i) <= c (c below the grid gives 0, above gives n-1).
-int64_t cellBelow(const Box& bounds, const std::array<uint32_t, 3>& dims, int a, double c) {
-  const int64_t n = dims[a];
-  const double lo = bounds.lo[a], hi = bounds.hi[a];
-  double guess = std::floor((c - lo) / (hi - lo) * double(n));
+// Largest i in [0, n-1] with b[i] <= c (c below the grid gives 0, above gives n-1). The multiplication only guesses;
+// the comparisons with the table (the values of cellBoundary) decide.
+int64_t cellBelow(const CellBoundaries& cb, int a, double c) {
+  const double* b = cb.b[a].data();
+  const int64_t n = cb.dims[a];
+  double guess = std::floor((c - b[0]) * cb.cellsPerUnit[a]);
   if (!(guess >= 0)) guess = 0;
   if (guess > double(n - 1)) guess = double(n - 1);
   int64_t i = int64_t(guess);
-  while (i > 0 && cellBoundary(bounds, dims, a, i) > c) --i;
-  while (i < n - 1 && cellBoundary(bounds, dims, a, i + 1) <= c) ++i;
+  while (i > 0 && b[i] > c) --i;
+  while (i < n - 1 && b[i + 1] <= c) ++i;
   return i;
 }
 
-// Smallest i in [0, n-1] with b(i+1) >= c.
-int64_t cellAbove(const Box& bounds, const std::array<uint32_t, 3>& dims, int a, double c) {
-  const int64_t n = dims[a];
-  int64_t i = cellBelow(bounds, dims, a, c);
-  while (i > 0 && cellBoundary(bounds, dims, a, i) >= c) --i;
-  while (i < n - 1 && cellBoundary(bounds, dims, a, i + 1) < c) ++i;
+// Smallest i in [0, n-1] with b[i+1] >= c.
+int64_t cellAbove(const CellBoundaries& cb, int a, double c) {
+  const double* b = cb.b[a].data();
+  const int64_t n = cb.dims[a];
+  int64_t i = cellBelow(cb, a, c);
+  while (i > 0 && b[i] >= c) --i;
+  while (i < n - 1 && b[i + 1] < c) ++i;
   return i;
 }
 
 }  // namespace
 
-GridWalker::GridWalker(const Box& bounds, const std::array<uint32_t, 3>& dims, const Ray& ray)
-    : bounds_(bounds), dims_(dims) {
+void GridWalker::init(const CellBoundaries& cells, const Ray& ray) {
   done_ = true;
   for (int a = 0; a < 3; ++a) {
     org_[a] = ray.origin[a];
     dir_[a] = ray.direction[a];
+    bnd_[a] = cells.b[a].data();
+    dims_[a] = cells.dims[a];
   }
   if (!isFinite(ray.origin) || !isFinite(ray.direction) || std::isnan(ray.tMin) || std::isnan(ray.tMax)) return;
   if (ray.direction.x == 0 && ray.direction.y == 0 && ray.direction.z == 0) return;
-  if (dims[0] == 0 || dims[1] == 0 || dims[2] == 0) return;
+  if (dims_[0] == 0 || dims_[1] == 0 || dims_[2] == 0) return;
 
-  double scale = 0, minCell = std::numeric_limits<double>::infinity();
-  double gridLo[3], gridHi[3];
+  double scale = 0;
   for (int a = 0; a < 3; ++a) {
-    gridLo[a] = boundary(a, 0);
-    gridHi[a] = boundary(a, dims[a]);
-    const double cell = (gridHi[a] - gridLo[a]) / dims[a];
-    if (cell > 0) minCell = std::min(minCell, cell);
-    const double mag = std::fabs(org_[a]) + std::max(std::fabs(gridLo[a]), std::fabs(gridHi[a]));
+    const double mag = std::fabs(org_[a]) + cells.magnitude[a];
     scale = std::max(scale, mag);
     // Positional slack per axis: a fraction of the cell plus the rounding of coordinates of this magnitude.
-    tolPos_[a] = kCellSlack * cell + 64 * kEps * mag;
-    tol_[a] = dir_[a] != 0 ? tolPos_[a] / std::fabs(dir_[a]) : 0;
+    tolPos_[a] = kCellSlack * cells.cellSize[a] + 64 * kEps * mag;
+    inv_[a] = 1.0 / dir_[a];
+    divide_[a] = !std::isnormal(inv_[a]);
+    tol_[a] = dir_[a] == 0 ? 0 : divide_[a] ? tolPos_[a] / std::fabs(dir_[a]) : tolPos_[a] * std::fabs(inv_[a]);
   }
-  if (!std::isfinite(minCell)) minCell = 0;
-  const double dirLength = length(ray.direction);
-  hitSlack_ = (kCellSlack * minCell + 64 * kEps * scale) / dirLength;
+  // Divided by the largest component rather than the length (no square root): at most sqrt(3) times larger, and a
+  // larger slack only makes the stop rule more careful.
+  const double dirMax = std::max({std::fabs(dir_[0]), std::fabs(dir_[1]), std::fabs(dir_[2])});
+  hitSlack_ = (kCellSlack * cells.minCell + 64 * kEps * scale) / dirMax;
 
   // Slab test against the closed grid box [b(0), b(n)].
   double tLo = ray.tMin, tExitBox = ray.tMax;
   int entry = -1;
   for (int a = 0; a < 3; ++a) {
+    const double gridLo = bnd_[a][0], gridHi = bnd_[a][dims_[a]];
     if (dir_[a] == 0) {
-      if (org_[a] < gridLo[a] || org_[a] > gridHi[a]) return;
+      if (org_[a] < gridLo || org_[a] > gridHi) return;
       continue;
     }
-    double t0 = (gridLo[a] - org_[a]) / dir_[a];
-    double t1 = (gridHi[a] - org_[a]) / dir_[a];
+    double t0 = divide_[a] ? (gridLo - org_[a]) / dir_[a] : (gridLo - org_[a]) * inv_[a];
+    double t1 = divide_[a] ? (gridHi - org_[a]) / dir_[a] : (gridHi - org_[a]) * inv_[a];
     if (t0 > t1) std::swap(t0, t1);
     t0 -= tol_[a] + kRel * std::fabs(t0);
     t1 += tol_[a] + kRel * std::fabs(t1);
@@ -92,21 +94,90 @@ GridWalker::GridWalker(const Box& bounds, const std::array<uint32_t, 3>& dims, c
   for (int a = 0; a < 3; ++a) {
     const double p = dir_[a] == 0 ? org_[a] : org_[a] + tLo * dir_[a];
     if (dir_[a] > 0) {
-      idx_[a] = cellBelow(bounds, dims, a, p - tolPos_[a]);
+      idx_[a] = cellBelow(cells, a, p - tolPos_[a]);
       step_[a] = 1;
     } else if (dir_[a] < 0) {
-      idx_[a] = cellAbove(bounds, dims, a, p + tolPos_[a]);
+      idx_[a] = cellAbove(cells, a, p + tolPos_[a]);
       step_[a] = -1;
     } else {
-      idx_[a] = cellBelow(bounds, dims, a, p);
+      idx_[a] = cellBelow(cells, a, p);
       step_[a] = 0;
     }
   }
   for (int a = 0; a < 3; ++a) tNext_[a] = nextT(a);
   tCur_ = tLo;
   entryAxis_ = entry;
-  maxSteps_ = uint64_t(dims[0]) + dims[1] + dims[2] + 3;
+  maxSteps_ = dims_[0] + dims_[1] + dims_[2] + 3;
   done_ = false;
+}
+
+void GridWalker::queueExtras(int m, double tm, const WalkCell& from, bool n1, bool n2) {
+  int others[2], count = 0;
+  if (n1) others[count++] = m == 0 ? 1 : 0;
+  if (n2) others[count++] = m == 2 ? 1 : 2;
+  for (int subset = 1; subset < (1 << count); ++subset) {
+    int64_t c[3] = {idx_[0], idx_[1], idx_[2]};
+    int lastAxis = -1;
+    for (int s = 0; s < count; ++s)
+      if (subset & (1 << s)) {
+        c[others[s]] += step_[others[s]];
+        lastAxis = others[s];
+      }
+    if (uint64_t(c[0]) < dims_[0] && uint64_t(c[1]) < dims_[1] && uint64_t(c[2]) < dims_[2]) {
+      WalkCell& e = queue_[queued_++];
+      e = from;
+      e.idx = {uint32_t(c[0]), uint32_t(c[1]), uint32_t(c[2])};
+      e.tEnter = tm;
+      e.entryAxis = lastAxis;
+      e.extra = true;
+    }
+  }
+}
+
+// Skips the empty block holding the current cell (no primitive can be found in it). Its exit parameter tX is the
+// smallest crossing of its far faces (on axis m). When the ray passes within twice the tolerance of another far face
+// at tX (near an edge or corner of the block; by monotony that is where it comes closest), nothing is skipped and the
+// ordinary steps with their extra cells handle it. Otherwise every axis is advanced, without reporting cells, over
+// the boundaries inside the block that the ray crosses before T = tX - 2 (tol + kRel |tX|): those steps only leave
+// cells of the block, and none of their extra cells can lie outside it (the ray is farther than the tolerance from
+// the other far faces, and the steps near the exit face come after T). The walker is then in the state the ordinary
+// walk reaches at T and goes on from there; every index increment counts as a step, so the bound on steps holds.
+void GridWalker::fastForward() {
+  const int64_t mask = blockMask();
+  double tB[3];
+  int64_t far[3];
+  for (int a = 0; a < 3; ++a) {
+    if (step_[a] == 0) {
+      tB[a] = std::numeric_limits<double>::infinity();
+      far[a] = -1;
+      continue;
+    }
+    far[a] = step_[a] > 0 ? std::min<int64_t>((idx_[a] | mask) + 1, int64_t(dims_[a])) : (idx_[a] & ~mask);
+    const double b = bnd_[a][far[a]];
+    tB[a] = divide_[a] ? (b - org_[a]) / dir_[a] : (b - org_[a]) * inv_[a];
+  }
+  int m = 0;
+  if (tB[1] < tB[m]) m = 1;
+  if (tB[2] < tB[m]) m = 2;
+  const double tX = tB[m];
+  if (!std::isfinite(tX)) return;
+  for (int a = 0; a < 3; ++a)
+    if (a != m && std::isfinite(tB[a]) &&
+        (tB[a] - tX) * std::fabs(dir_[a]) <= 2 * (tolPos_[a] + kRel * std::fabs(tX * dir_[a])))
+      return;
+  const double T = tX - 2 * (tol_[m] + kRel * std::fabs(tX));
+  for (int a = 0; a < 3; ++a) {
+    if (step_[a] == 0) continue;
+    while (idx_[a] + (step_[a] > 0 ? 1 : 0) != far[a] && tNext_[a] < T) {
+      idx_[a] += step_[a];
+      ++steps_;
+      if (tNext_[a] > tCur_) {
+        tCur_ = tNext_[a];
+        entryAxis_ = a;
+      }
+      tNext_[a] = nextT(a);
+    }
+  }
 }
 
 namespace {
@@ -154,8 +225,7 @@ Hit traceRay(const Accel& accel, const Ray& ray, TraceStats* stats) {
     for (uint32_t id = 0; id < n; ++id) consider(accel, id, ray, best, st);
   } else {
     for (uint32_t id : accel.alwaysTested) consider(accel, id, ray, best, st);
-    const Grid& grid = *accel.grid;
-    GridWalker walker(grid.bounds, grid.dims, ray);
+    GridWalker walker(accel, ray);
     Mailbox mailbox;
     WalkCell cell;
     while (walker.next(cell)) {
@@ -195,8 +265,7 @@ bool occluded(const Accel& accel, const Ray& ray, TraceStats* stats) {
       ++st.tests;
       hit = testPrim(accel, accel.alwaysTested[i], ray, t);
     }
-    const Grid& grid = *accel.grid;
-    GridWalker walker(grid.bounds, grid.dims, ray);
+    GridWalker walker(accel, ray);
     Mailbox mailbox;
     WalkCell cell;
     while (!hit && walker.next(cell)) {
@@ -224,8 +293,7 @@ CellHit firstOccupiedCell(const Accel& accel, const Ray& ray, TraceStats* stats)
   TraceStats st;
   st.rays = 1;
   CellHit result;
-  const Grid& grid = *accel.grid;
-  GridWalker walker(grid.bounds, grid.dims, ray);
+  GridWalker walker(accel, ray);
   WalkCell cell;
   while (walker.next(cell)) {
     ++st.cells;

@@ -19,6 +19,19 @@ enum class AccelKind : uint8_t { Grid, None };
 // Throws UsageError for a name other than "grid" or "none".
 AccelKind parseAccel(const std::string& name);
 
+// The cell boundaries of a grid as tables: b[a][i] == cellBoundary(bounds, dims, a, i) for i in [0, dims[a]], the
+// very same values computed once, so that the walker reads them instead of evaluating the formula (a division by n)
+// at every step. Also the per-axis constants the walker's tolerances need. World units.
+struct CellBoundaries {
+  std::array<uint32_t, 3> dims{0, 0, 0};
+  std::array<std::vector<double>, 3> b;
+  std::array<double, 3> cellsPerUnit{0, 0, 0};  // n / (b(n) - b(0)): a first guess of a cell index only
+  std::array<double, 3> cellSize{0, 0, 0};      // (b(n) - b(0)) / n
+  std::array<double, 3> magnitude{0, 0, 0};     // max(|b(0)|, |b(n)|)
+  double minCell = 0;                           // smallest positive cellSize, 0 when there is none
+};
+CellBoundaries makeCellBoundaries(const Box& bounds, const std::array<uint32_t, 3>& dims);
+
 inline constexpr uint32_t kEmptyCell = 0xffffffffu;
 inline constexpr uint32_t kSolidCell = 0xfffffffeu;
 
@@ -31,6 +44,8 @@ struct Accel {
   std::vector<Plane> planes;
   // Planes and Grid::outsidePrims, ascending ids: tested for every ray, before the walk.
   std::vector<uint32_t> alwaysTested;
+  // Boundary tables of the grid, for the walker.
+  CellBoundaries boundaries;
 
   // Two-level lookup: the grid is cut into blocks of 2^blockShift cells a side; blockSlot holds, for each block,
   // kEmptyCell or the index of its table in cellSlots (2^(3*blockShift) entries, x fastest), whose entries are the

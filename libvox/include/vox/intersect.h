@@ -9,9 +9,10 @@
 
 namespace vox {
 
-// A triangle prepared for the Moller-Trumbore test: first vertex and the two edges from it. World space.
+// A triangle prepared for the ray test: first vertex, the two edges from it and their (unnormalized) cross product
+// n = e1 x e2. World space.
 struct TriangleData {
-  Vec3 v0, e1, e2;
+  Vec3 v0, e1, e2, n;
 };
 TriangleData prepareTriangle(const Triangle& t);
 

@@ -2,8 +2,9 @@
 // any-hit queries built on it.
 //
 // Robustness measures (docs/trace.md):
-// - Every cell boundary is cellBoundary(), the voxelizer's formula; the t of the next boundary on each axis is
-//   recomputed from it at every step ((b - o) / d, relative error a few ulps), never accumulated from tDelta.
+// - Every cell boundary is cellBoundary(), the voxelizer's formula (read from tables holding its values); the t of
+//   the next boundary on each axis is recomputed from it at every step ((b - o) * (1 / d), relative error a few
+//   ulps), never accumulated from tDelta.
 // - Axes are stepped one at a time in the order of those t. When, at a step, the ray is within a small positional
 //   tolerance of another axis's next boundary (a ray through an edge or corner, or close to one), the neighbouring
 //   cells across those boundaries are visited too ("extra" cells), so rounding in the order of near-equal crossings
@@ -16,6 +17,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
 
 #include "vox/accel.h"
 #include "vox/grid.h"
@@ -35,9 +37,28 @@ struct WalkCell {
 
 class GridWalker {
  public:
-  // Prepares the walk of `ray` over [ray.tMin, ray.tMax] through the grid of `bounds` and `dims`. A ray that misses
-  // the grid, or has a zero or non-finite direction, yields no cell.
-  GridWalker(const Box& bounds, const std::array<uint32_t, 3>& dims, const Ray& ray);
+  // Prepares the walk of `ray` over [ray.tMin, ray.tMax] through the grid of `cells` (which must outlive the walker;
+  // Accel::boundaries). A ray that misses the grid, or has a zero or non-finite direction, yields no cell.
+  GridWalker(const CellBoundaries& cells, const Ray& ray) { init(cells, ray); }
+  // The walk of traceRay and friends: through accel.boundaries, and skipping the cells of empty blocks of the
+  // two-level table (Accel::blockSlot) in one jump each (see fastForward); cells in empty blocks may therefore not
+  // be reported. `accel` must outlive the walker.
+  GridWalker(const Accel& accel, const Ray& ray) {
+    init(accel.boundaries, ray);
+    if (accel.blockShift != 0 && !done_) {
+      blockSlot_ = accel.blockSlot.data();
+      shift_ = accel.blockShift;
+      blockDims_[0] = accel.blockDims[0];
+      blockDims_[1] = accel.blockDims[1];
+      checkBlock_ = true;
+    }
+  }
+  // The same walk through the grid of `bounds` and `dims`; builds the boundary tables first (allocates: for tests
+  // and one-off walks, not for tracing many rays).
+  GridWalker(const Box& bounds, const std::array<uint32_t, 3>& dims, const Ray& ray)
+      : owned_(std::make_unique<CellBoundaries>(makeCellBoundaries(bounds, dims))) {
+    init(*owned_, ray);
+  }
 
   // The next cell along the ray, in order of entry; false when the walk has left the grid or passed tMax.
   bool next(WalkCell& out) {
@@ -46,14 +67,21 @@ class GridWalker {
       return true;
     }
     if (done_) return false;
+    if (checkBlock_) [[unlikely]] {
+      checkBlock_ = false;
+      if (blockEmpty()) fastForward();
+    }
     out.idx = {uint32_t(idx_[0]), uint32_t(idx_[1]), uint32_t(idx_[2])};
     out.tEnter = tCur_;
     out.entryAxis = entryAxis_;
     out.extra = false;
-    int m = 0;
-    if (tNext_[1] < tNext_[m]) m = 1;
-    if (tNext_[2] < tNext_[m]) m = 2;
-    const double tm = tNext_[m];
+    // The axis of the nearest next boundary (first of equals), without branches: which axis wins is data
+    // dependent, and mispredicted branches cost more than the comparisons.
+    const double t0 = tNext_[0], t1 = tNext_[1], t2 = tNext_[2];
+    const int m01 = t1 < t0;
+    const double t01 = t1 < t0 ? t1 : t0;
+    const int m = t2 < t01 ? 2 : m01;
+    const double tm = t2 < t01 ? t2 : t01;
     out.tExit = tm;
     out.exitSlack = tol_[m] + kRel * std::fabs(tm);
     step(m, tm, out);
@@ -64,14 +92,22 @@ class GridWalker {
   double hitSlack(double t) const { return hitSlack_ + 1e-9 * std::fabs(t); }
   uint64_t stepsTaken() const { return steps_; }
 
+  // The parameter at which the ray crosses the plane x_axis = b, as the walker computes it for cell exits:
+  // (b - o) * (1 / d) when 1 / d is a normal number (a multiplication instead of a division per step; error at most
+  // 2 ulps more than the quotient, far inside the slack kRel), else (b - o) / d. Only for a nonzero d.
+  static double crossing(double b, double o, double d) {
+    const double inv = 1.0 / d;
+    return std::isnormal(inv) ? (b - o) * inv : (b - o) / d;
+  }
+
  private:
   static constexpr double kRel = 16 * std::numeric_limits<double>::epsilon();
 
-  double boundary(int axis, int64_t i) const { return cellBoundary(bounds_, dims_, axis, i); }
+  void init(const CellBoundaries& cells, const Ray& ray);
   double nextT(int a) const {
-    if (dir_[a] > 0) return (boundary(a, idx_[a] + 1) - org_[a]) / dir_[a];
-    if (dir_[a] < 0) return (boundary(a, idx_[a]) - org_[a]) / dir_[a];
-    return std::numeric_limits<double>::infinity();
+    if (step_[a] == 0) return std::numeric_limits<double>::infinity();
+    const double b = bnd_[a][idx_[a] + (step_[a] > 0 ? 1 : 0)];
+    return divide_[a] ? (b - org_[a]) / dir_[a] : (b - org_[a]) * inv_[a];
   }
   // Is the ray, at parameter tm, within tolerance of axis a's next boundary?
   bool near(int a, double tm) const {
@@ -84,48 +120,38 @@ class GridWalker {
       return;
     }
     // Neighbours across boundaries that the ray passes within tolerance of at this step (edges and corners).
-    int others[2], count = 0;
-    for (int a = 0; a < 3; ++a)
-      if (a != m && near(a, tm)) others[count++] = a;
-    for (int subset = 1; subset < (1 << count); ++subset) {
-      std::array<int64_t, 3> c = idx_;
-      int lastAxis = -1;
-      for (int s = 0; s < count; ++s)
-        if (subset & (1 << s)) {
-          c[others[s]] += step_[others[s]];
-          lastAxis = others[s];
-        }
-      if (inside(c)) {
-        WalkCell& e = queue_[queued_++];
-        e = from;
-        e.idx = {uint32_t(c[0]), uint32_t(c[1]), uint32_t(c[2])};
-        e.tEnter = tm;
-        e.entryAxis = lastAxis;
-        e.extra = true;
-      }
-    }
+    const int a1 = m == 0 ? 1 : 0, a2 = m == 2 ? 1 : 2;
+    const bool n1 = near(a1, tm), n2 = near(a2, tm);
+    if (n1 | n2) [[unlikely]]
+      queueExtras(m, tm, from, n1, n2);
     idx_[m] += step_[m];
-    if (idx_[m] < 0 || idx_[m] >= int64_t(dims_[m])) {
+    if (uint64_t(idx_[m]) >= dims_[m]) {  // also catches -1
       done_ = true;
       return;
     }
+    // Entering a new block: look whether it is empty before reporting its first cell.
+    if (blockSlot_ && (idx_[m] & blockMask()) == (step_[m] > 0 ? 0 : blockMask())) checkBlock_ = true;
     tCur_ = tm;
     entryAxis_ = m;
     tNext_[m] = nextT(m);
   }
-  bool inside(const std::array<int64_t, 3>& c) const {
-    for (int a = 0; a < 3; ++a)
-      if (c[a] < 0 || c[a] >= int64_t(dims_[a])) return false;
-    return true;
+  void queueExtras(int m, double tm, const WalkCell& from, bool n1, bool n2);
+  int64_t blockMask() const { return (int64_t(1) << shift_) - 1; }
+  bool blockEmpty() const {
+    const uint64_t bx = uint64_t(idx_[0]) >> shift_, by = uint64_t(idx_[1]) >> shift_, bz = uint64_t(idx_[2]) >> shift_;
+    return blockSlot_[bx + blockDims_[0] * (by + blockDims_[1] * bz)] == kEmptyCell;
   }
+  void fastForward();
 
-  Box bounds_;
-  std::array<uint32_t, 3> dims_;
-  double org_[3], dir_[3];
-  std::array<int64_t, 3> idx_{0, 0, 0};
+  std::unique_ptr<CellBoundaries> owned_;  // the tables, when the walker built them itself
+  const double* bnd_[3] = {nullptr, nullptr, nullptr};
+  uint64_t dims_[3] = {0, 0, 0};
+  double org_[3], dir_[3], inv_[3];
+  bool divide_[3] = {false, false, false};  // 1 / d is not a normal number: divide instead
+  int64_t idx_[3] = {0, 0, 0};
   int64_t step_[3] = {0, 0, 0};
   double tNext_[3];
-  double tol_[3];     // positional tolerance of each axis in ray parameter units (infinite for a zero component)
+  double tol_[3];     // positional tolerance of each axis in ray parameter units (0 for a zero component)
   double tolPos_[3];  // positional tolerance of each axis in world units
   double tCur_ = 0, tHi_ = 0;
   double hitSlack_ = 0;
@@ -134,6 +160,11 @@ class GridWalker {
   uint64_t steps_ = 0, maxSteps_ = 0;
   WalkCell queue_[3];
   int queued_ = 0;
+  // Empty-block skipping (Accel constructor only).
+  const uint32_t* blockSlot_ = nullptr;
+  uint32_t shift_ = 0;
+  uint64_t blockDims_[2] = {0, 0};
+  bool checkBlock_ = false;
 };
 
 // Counters of one thread's tracing; summed over threads for --stats.

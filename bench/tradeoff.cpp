@@ -17,11 +17,11 @@ int main(int argc, char** argv) {
   bool small = false;
   int threads = 0;
   vox::bench::TradeoffOptions options;
-  options.resolutions = {8, 16, 32, 64, 128, 256};
+  options.resolutions = {0, 8, 16, 32, 64, 128, 256};
   for (int i = 2; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--small")) {
       small = true;
-      options.resolutions = {4, 8, 16};
+      options.resolutions = {0, 4, 8, 16};
       options.imageSize = 48;
     } else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) {
       threads = std::atoi(argv[++i]);

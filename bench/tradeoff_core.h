@@ -81,9 +81,9 @@ inline Camera cameraFor(const Scene& scene) {
 }
 
 struct TradeoffOptions {
-  std::vector<uint32_t> resolutions;
+  std::vector<uint32_t> resolutions;  // cells on the longest axis; 0 stands for the default heuristic
   std::vector<OverlapMethod> methods{OverlapMethod::Exact, OverlapMethod::Sat, OverlapMethod::BBox, OverlapMethod::Center};
-  uint32_t imageSize = 128;
+  uint32_t imageSize = 256;
   bool trace = true;
 };
 
@@ -111,7 +111,7 @@ inline std::vector<TradeoffRow> measureTradeoff(const TradeoffScene& ts, const T
     Grid exact;
     for (OverlapMethod method : options.methods) {
       VoxelizeOptions vo;
-      vo.resolution = res;
+      if (res > 0) vo.resolution = res;  // 0: the default heuristic
       vo.method = method;
       VoxelizeStats vs;
       const auto t0 = std::chrono::steady_clock::now();

@@ -76,9 +76,9 @@ check face_index 2 "$V" "$T/bad.obj" -o "$T/x.vgrid"; expect_err face_index "bad
 printf 'Group {\n numObjects 1\n TriangleMesh { obj_file missing.obj }\n}\n' >"$T/mesh.txt"
 check missing_mesh 2 "$V" "$T/mesh.txt" -o "$T/x.vgrid"; expect_err missing_mesh "missing.obj"
 check zero_grid 1 "$V" "$SRC/scenes/scene5_01_sphere.txt" -o "$T/x.vgrid" --grid 0 4 4; expect_err zero_grid "dimension"
-check negative_grid 1 "$V" "$SRC/scenes/scene5_01_sphere.txt" -o "$T/x.vgrid" --grid -3 4 4
+check negative_grid 1 "$V" "$SRC/scenes/scene5_01_sphere.txt" -o "$T/x.vgrid" --grid -3 4 4; expect_err negative_grid "grid"
 check absurd_grid 2 "$V" "$SRC/scenes/scene5_01_sphere.txt" -o "$T/x.vgrid" --grid 100000 100000 100000; expect_err absurd_grid "MiB"
-check bad_method 1 "$V" "$SRC/scenes/scene5_01_sphere.txt" -o "$T/x.vgrid" --method magic
+check bad_method 1 "$V" "$SRC/scenes/scene5_01_sphere.txt" -o "$T/x.vgrid" --method magic; expect_err bad_method "method"
 check unwritable 3 "$V" "$SRC/scenes/scene5_01_sphere.txt" -o "$T/no/such/dir/x.vgrid"; expect_err unwritable "x.vgrid"
 [ ! -e "$T/x.vgrid" ] || { echo "FAIL a failed run left an output file"; fails=$((fails + 1)); }
 ls -a "$T" | grep -q '\.tmp' && { echo "FAIL temporary file left behind"; fails=$((fails + 1)); }

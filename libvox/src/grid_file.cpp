@@ -21,7 +21,7 @@ constexpr size_t kHeaderSize = 32;  // magic, version, flags, payload size, chec
 
 // 64-bit multiplicative hash over 8-byte words: any change of one word changes the result (xor then multiply by an
 // odd constant are bijections), and it runs at memory speed.
-uint64_t checksum(const char* data, size_t size) {
+uint64_t wordChecksum(const char* data, size_t size) {
   uint64_t h = 0x9E3779B97F4A7C15ull ^ size;
   size_t i = 0;
   for (; i + 8 <= size; i += 8) {
@@ -149,6 +149,8 @@ Material getMaterial(ByteReader& r) {
 
 }  // namespace
 
+uint64_t gridChecksum(const char* payload, size_t size) { return wordChecksum(payload, size); }
+
 std::string encodeGridFile(const Scene& scene, const Grid& grid) {
   ByteWriter w;
   // The header is filled in last, in place, so the (possibly large) payload is never copied.
@@ -210,7 +212,7 @@ std::string encodeGridFile(const Scene& scene, const Grid& grid) {
 
   std::string bytes = std::move(w.bytes());
   const uint64_t payloadSize = bytes.size() - kHeaderSize;
-  const uint64_t sum = checksum(bytes.data() + kHeaderSize, payloadSize);
+  const uint64_t sum = wordChecksum(bytes.data() + kHeaderSize, payloadSize);
   const uint32_t version = kGridFileVersion, flags = 0;
   std::memcpy(bytes.data(), kMagic, 8);
   std::memcpy(bytes.data() + 8, &version, 4);
@@ -236,7 +238,7 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
       fail<InputError>(name, ": truncated at byte ", bytes.size(), " (header promises ", payloadSize + kHeaderSize, " bytes)");
     fail<InputError>(name, ": ", bytes.size() - kHeaderSize - payloadSize, " unexpected bytes after the end of the grid");
   }
-  if (checksum(bytes.data() + kHeaderSize, payloadSize) != expected)
+  if (wordChecksum(bytes.data() + kHeaderSize, payloadSize) != expected)
     fail<InputError>(name, ": checksum mismatch: the file is corrupt");
 
   ByteReader r(bytes, kHeaderSize, name);

@@ -24,6 +24,9 @@ void writeGridFile(const std::string& path, const Scene& scene, const Grid& grid
 // for a truncated, corrupt or newer-version file.
 GridFile readGridFile(const std::string& path);
 
+// The checksum of docs/grid-format.md over a payload (the bytes after the 32-byte header).
+uint64_t gridChecksum(const char* payload, size_t size);
+
 // The same on bytes in memory (fuzzing, tests). `name` is used in error messages.
 std::string encodeGridFile(const Scene& scene, const Grid& grid);
 GridFile decodeGridFile(const std::string& bytes, const std::string& name);

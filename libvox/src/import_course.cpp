@@ -498,6 +498,18 @@ class CourseParser {
     --nesting_;
   }
 
+  // Leaf objects are parsed out of line (noinline) so that the recursive frames stay small under sanitizers.
+  [[gnu::noinline]] void parseTriangle(const Token& t, const Mat4& m, Primitives& out) {
+    expect("{");
+    Triangle tri;
+    tri.v[0] = transformPoint(m, readField("vertex0"));
+    tri.v[1] = transformPoint(m, readField("vertex1"));
+    tri.v[2] = transformPoint(m, readField("vertex2"));
+    expect("}");
+    tri.material = currentMaterial(t);
+    out.triangles.push_back(tri);
+  }
+
   void parseObjectBody(const Token& t, const Mat4& m, Primitives& out) {
     if (t.text == "Group") {
       parseGroup(m, out);
@@ -506,14 +518,7 @@ class CourseParser {
     } else if (t.text == "Plane") {
       parsePlane(t, m, out);
     } else if (t.text == "Triangle") {
-      expect("{");
-      Triangle tri;
-      tri.v[0] = transformPoint(m, readField("vertex0"));
-      tri.v[1] = transformPoint(m, readField("vertex1"));
-      tri.v[2] = transformPoint(m, readField("vertex2"));
-      expect("}");
-      tri.material = currentMaterial(t);
-      out.triangles.push_back(tri);
+      parseTriangle(t, m, out);
     } else if (t.text == "TriangleMesh") {
       parseTriangleMesh(t, m, out);
     } else if (t.text == "Transform") {
@@ -552,7 +557,7 @@ class CourseParser {
     }
   }
 
-  void parseSphere(const Token& t, const Mat4& m, Primitives& out) {
+  [[gnu::noinline]] void parseSphere(const Token& t, const Mat4& m, Primitives& out) {
     expect("{");
     Sphere s;
     s.center = readField("center");
@@ -572,7 +577,7 @@ class CourseParser {
     out.spheres.push_back(s);
   }
 
-  void parsePlane(const Token& t, const Mat4& m, Primitives& out) {
+  [[gnu::noinline]] void parsePlane(const Token& t, const Mat4& m, Primitives& out) {
     expect("{");
     const Vec3 n = readDirection("normal");
     expect("offset");
@@ -592,7 +597,7 @@ class CourseParser {
     out.planes.push_back(p);
   }
 
-  void parseTriangleMesh(const Token& t, const Mat4& m, Primitives& out) {
+  [[gnu::noinline]] void parseTriangleMesh(const Token& t, const Mat4& m, Primitives& out) {
     expect("{");
     expect("obj_file");
     const Token name = next("a file name");

@@ -139,12 +139,23 @@ class GltfReader {
     if (textured) warn("base colour textures are used as their baseColorFactor only");
   }
 
+  // The recursion keeps only a matrix per level; everything with a large frame (error formatting, mesh reading)
+  // lives in enterNode, kept out of line so that 256 levels stay far inside the stack even under sanitizers.
   void visitNode(int index, const Mat4& parent, std::vector<bool>& onPath, int depth) {
+    const Mat4 world = enterNode(index, parent, onPath, depth);
+    const size_t i = static_cast<size_t>(index);
+    onPath[i] = true;
+    for (int child : model_.nodes[i].children) visitNode(child, world, onPath, depth + 1);
+    onPath[i] = false;
+  }
+
+  // Checks node `index`, reads its camera, light and mesh, and returns its world matrix.
+  [[gnu::noinline]] Mat4 enterNode(int index, const Mat4& parent, const std::vector<bool>& onPath, int depth) {
     if (index < 0 || static_cast<size_t>(index) >= model_.nodes.size())
       failHere("node ", index, " does not exist (", model_.nodes.size(), " nodes)");
     const size_t i = static_cast<size_t>(index);
     if (onPath[i]) failHere("node ", index, ": cycle in the node hierarchy");
-    constexpr int kMaxDepth = 256;  // recursion; frames are large under sanitizers
+    constexpr int kMaxDepth = 256;  // recursion depth
     if (depth > kMaxDepth) failHere("node ", index, ": hierarchy deeper than ", kMaxDepth);
     // glTF requires strict trees, but a file that shares subtrees could make the walk exponential: cap it.
     constexpr size_t kMaxVisits = 1'000'000;
@@ -176,10 +187,7 @@ class GltfReader {
     if (node.camera >= 0 && !scene_.camera) readCamera(index, node.camera, world);
     readLight(index, node, world);
     if (node.mesh >= 0) readMesh(index, node.mesh, world);
-
-    onPath[i] = true;
-    for (int child : node.children) visitNode(child, world, onPath, depth + 1);
-    onPath[i] = false;
+    return world;
   }
 
   void readCamera(int nodeIndex, int cameraIndex, const Mat4& world) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "cell_range.h"
 #include "vox/error.h"
 
 namespace vox {
@@ -38,25 +39,11 @@ int64_t findCell(const Grid& grid, uint64_t key) {
   return it - grid.cellKeys.begin();
 }
 
-// Cell c meets [lo, hi] iff b(c) <= hi and b(c+1) >= lo. The boundary formula is monotone in c (a product and a
-// division of non-negative values, then an addition, are each monotone under round-to-nearest), so a division
-// gives a first guess and a few steps against the true formula make it exact.
 std::array<int64_t, 2> cellRange(const Box& bounds, const std::array<uint32_t, 3>& dims, int axis, double lo,
                                  double hi) {
-  const int64_t n = dims[axis];
-  const double l = bounds.lo[axis], h = bounds.hi[axis];
-  if (!(hi >= l) || !(lo <= h)) return {1, 0};
-  auto boundary = [&](int64_t c) { return cellBoundary(bounds, dims, axis, c); };
-  const double scale = double(n) / (h - l);
-  // first = smallest c in [0, n-1] with b(c+1) >= lo
-  int64_t first = std::clamp<int64_t>(int64_t(std::floor((lo - l) * scale)), 0, n - 1);
-  while (first > 0 && boundary(first) >= lo) --first;
-  while (first < n - 1 && boundary(first + 1) < lo) ++first;
-  // last = largest c in [0, n-1] with b(c) <= hi
-  int64_t last = std::clamp<int64_t>(int64_t(std::floor((hi - l) * scale)), 0, n - 1);
-  while (last < n - 1 && boundary(last + 1) <= hi) ++last;
-  while (last > 0 && boundary(last) > hi) --last;
-  return {first, last};
+  const double scale = double(dims[axis]) / (bounds.hi[axis] - bounds.lo[axis]);
+  return cellRangeOnAxis(
+      dims[axis], scale, [&](int64_t c) { return cellBoundary(bounds, dims, axis, c); }, lo, hi);
 }
 
 }  // namespace vox

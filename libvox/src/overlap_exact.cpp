@@ -10,6 +10,8 @@
 #include <CGAL/Interval_nt.h>
 #include <CGAL/intersections.h>
 
+#include <optional>
+
 #include "sphere_overlap.h"
 #include "vox/overlap.h"
 
@@ -41,36 +43,29 @@ bool triangleBoxExact(const Triangle& t, const Box& box) {
   return CGAL::do_intersect(K::Segment_3(lo, hi), cuboid);
 }
 
-// Interval arithmetic first (CGAL's own filtering technique); exact rationals only when an interval comparison is
-// uncertain, which throws Uncertain_conversion_exception.
-bool sphereBoxFiltered(const Sphere& s, const Box& box, bool* usedFallback) {
-  {
-    CGAL::Protect_FPU_rounding<true> guard;
-    try {
-      const bool result = sphereSurfaceMeetsBox<CGAL::Interval_nt<false>>(s, box);
-      if (usedFallback) *usedFallback = false;
-      return result;
-    } catch (const CGAL::Uncertain_conversion_exception&) {
-    }
-  }
-  if (usedFallback) *usedFallback = true;
-  return sphereSurfaceMeetsBox<CGAL::Gmpq>(s, box);
-}
-
-}  // namespace vox
-
-namespace vox {
-bool sphereBoxExact(const Sphere& s, const Box& box) { return sphereBoxFiltered(s, box, nullptr); }
-}  // namespace vox
-
-namespace vox {
-// `sat` for spheres: the exact method's interval stage alone; where intervals cannot decide, the cell is taken.
-bool sphereBoxSat(const Sphere& s, const Box& box) {
+// The interval stage shared by `exact` and `sat`: CGAL's own filtering technique. nullopt when an interval
+// comparison is uncertain (CGAL throws Uncertain_conversion_exception for it).
+namespace {
+std::optional<bool> sphereBoxInterval(const Sphere& s, const Box& box) {
   CGAL::Protect_FPU_rounding<true> guard;
   try {
     return sphereSurfaceMeetsBox<CGAL::Interval_nt<false>>(s, box);
   } catch (const CGAL::Uncertain_conversion_exception&) {
-    return true;
+    return std::nullopt;
   }
 }
+}  // namespace
+
+// Exact rationals only when the intervals cannot decide.
+bool sphereBoxFiltered(const Sphere& s, const Box& box, bool* usedFallback) {
+  const std::optional<bool> decided = sphereBoxInterval(s, box);
+  if (usedFallback) *usedFallback = !decided;
+  return decided ? *decided : sphereSurfaceMeetsBox<CGAL::Gmpq>(s, box);
+}
+
+bool sphereBoxExact(const Sphere& s, const Box& box) { return sphereBoxFiltered(s, box, nullptr); }
+
+// `sat` for spheres: the interval stage alone; where intervals cannot decide, the cell is taken.
+bool sphereBoxSat(const Sphere& s, const Box& box) { return sphereBoxInterval(s, box).value_or(true); }
+
 }  // namespace vox

@@ -71,17 +71,6 @@ struct TriangleFilter {
     for (int i = 0; i < 3; ++i)
       for (int a = 0; a < 3; ++a) {
         const int b = kNext[a], c = kPrev[a];
-        double mn = 0, mx = 0, err = 0;  // vertex 0 projects to exactly 0
-        for (int k = 0; k < 2; ++k) {
-          const double t1 = edges[i][c] * d[k][b], t2 = edges[i][b] * d[k][c];
-          const double s = t1 - t2;
-          mn = std::min(mn, s);
-          mx = std::max(mx, s);
-          err = std::max(err, 8 * kU * (std::fabs(t1) + std::fabs(t2)) + kTiny);
-        }
-        edgeProj[i][a][0] = mn;
-        edgeProj[i][a][1] = mx;
-        edgeProjErr[i][a] = err;
         // Projections of the three vertices (v0 at exactly 0) and their error bounds.
         double sv[3] = {0, 0, 0}, ev[3] = {0, kTiny, kTiny};
         for (int k = 0; k < 2; ++k) {
@@ -89,6 +78,9 @@ struct TriangleFilter {
           sv[k + 1] = t1 - t2;
           ev[k + 1] = 8 * kU * (std::fabs(t1) + std::fabs(t2)) + kTiny;
         }
+        edgeProj[i][a][0] = std::min({sv[0], sv[1], sv[2]});
+        edgeProj[i][a][1] = std::max({sv[0], sv[1], sv[2]});
+        edgeProjErr[i][a] = std::max(ev[1], ev[2]);
         const int e0 = i, e1 = (i + 1) % 3, third = (i + 2) % 3;
         const double edgeHi = std::max(sv[e0], sv[e1]), edgeLo = std::min(sv[e0], sv[e1]);
         const double sideErr = 2 * (ev[third] + std::max(ev[e0], ev[e1]));

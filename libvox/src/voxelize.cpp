@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "cell_range.h"
 #include "radix_sort.h"
 #include "triangle_filter.h"
 #include "vox/error.h"
@@ -70,23 +71,6 @@ std::optional<CellRange> rangeOf(const Grid& grid, const Box& box) {
     r.last[a] = l;
   }
   return r;
-}
-
-// cellRange on precomputed boundaries b[0..n] (b[n] == hi): a guess from the scale, then exact steps.
-std::array<int64_t, 2> rangeInBoundaries(const std::vector<double>& b, double scale, double lo, double hi) {
-  const int64_t n = int64_t(b.size()) - 1;
-  if (!(hi >= b[0]) || !(lo <= b[n])) return {1, 0};
-  auto guess = [&](double x) {
-    const double g = std::floor((x - b[0]) * scale);
-    return g < 0 ? int64_t(0) : (g > double(n - 1) ? n - 1 : int64_t(g));
-  };
-  int64_t first = guess(lo);
-  while (first > 0 && b[first] >= lo) --first;
-  while (first < n - 1 && b[first + 1] < lo) ++first;
-  int64_t last = guess(hi);
-  while (last < n - 1 && b[last + 1] <= hi) ++last;
-  while (last > 0 && b[last] > hi) --last;
-  return {first, last};
 }
 
 bool inside(const Box& inner, const Box& outer) {
@@ -329,7 +313,9 @@ Grid voxelizeScene(const Scene& scene, const VoxelizeOptions& options, VoxelizeS
         if (sweep.usable) {
           const auto [lo, hi] = sweep.range(boundary[b][idx[b]], boundary[b][idx[b] + 1], boundary[c][idx[c]],
                                             boundary[c][idx[c] + 1]);
-          const auto r = rangeInBoundaries(boundary[a], boundaryScale[a], lo, hi);
+          const auto& table = boundary[a];
+          const auto r = cellRangeOnAxis(
+              int64_t(dims[a]), boundaryScale[a], [&](int64_t i) { return table[size_t(i)]; }, lo, hi);
           from = std::max(from, r[0]);
           to = std::min(to, r[1]);
         }

@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include "triangle_kernel.h"
+
 namespace vox {
 
 TriangleData prepareTriangle(const Triangle& t) {
@@ -23,25 +25,14 @@ SphereData prepareSphere(const Sphere& s) {
   return d;
 }
 
-// Cramer's rule on o + t d = v0 + u e1 + v e2 (the Moller-Trumbore system) with the normal n = e1 x e2
-// precomputed: with s = o - v0 and c = s x d, det = -d.n, u = e2.c / det, v = -e1.c / det, t = s.n / det. The closed
-// barycentric test compares the numerators with det (sign-aware) instead of dividing first, so the one division
-// is paid by candidates that pass it; a miss costs 15 multiplications and no division.
+// The arithmetic lives in triangle_kernel.h, shared with the packet test.
 bool intersectTriangle(const TriangleData& tri, const Ray& ray, double& t) {
+  const Vec3& o = ray.origin;
   const Vec3& d = ray.direction;
-  const double det = -dot(d, tri.n);
-  if (det == 0 || !std::isfinite(det)) return false;
-  const Vec3 s = ray.origin - tri.v0;
-  const Vec3 c = cross(s, d);
-  const double uu = dot(tri.e2, c);
-  const double vv = -dot(tri.e1, c);
-  if (det > 0) {
-    if (!(uu >= 0 && vv >= 0 && uu + vv <= det)) return false;
-  } else {
-    if (!(uu <= 0 && vv <= 0 && uu + vv >= det)) return false;
-  }
-  const double hitT = dot(s, tri.n) / det;
-  if (!(hitT >= ray.tMin && hitT <= ray.tMax)) return false;
+  const double v0[3] = {tri.v0.x, tri.v0.y, tri.v0.z}, e1[3] = {tri.e1.x, tri.e1.y, tri.e1.z},
+               e2[3] = {tri.e2.x, tri.e2.y, tri.e2.z}, n[3] = {tri.n.x, tri.n.y, tri.n.z};
+  double hitT;
+  if (!kernel::triangleHit(v0, e1, e2, n, o.x, o.y, o.z, d.x, d.y, d.z, ray.tMin, ray.tMax, hitT)) return false;
   t = hitT;
   return true;
 }

@@ -8,9 +8,7 @@ namespace vox {
 namespace {
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
-// Fraction of a cell by which boundaries are treated as fuzzy: rays passing this close to an edge or corner also
-// visit the cells across it. Costs an extra cell visit about once per million crossings.
-constexpr double kCellSlack = 1e-6;
+constexpr double kRel = kWalkRel;
 
 // Largest i in [0, n-1] with b[i] <= c (c below the grid gives 0, above gives n-1). The multiplication only guesses;
 // the comparisons with the table (the values of cellBoundary) decide.
@@ -38,6 +36,54 @@ int64_t cellAbove(const CellBoundaries& cb, int a, double c) {
 
 }  // namespace
 
+RayAxes rayAxes(const CellBoundaries& cells, const Ray& ray) {
+  RayAxes ax;
+  double scale = 0;
+  for (int a = 0; a < 3; ++a) {
+    const double d = ray.direction[a];
+    const double mag = std::fabs(ray.origin[a]) + cells.magnitude[a];
+    scale = std::max(scale, mag);
+    // Positional slack per axis: a fraction of the cell plus the rounding of coordinates of this magnitude.
+    ax.tolPos[a] = kCellSlack * cells.cellSize[a] + 64 * kEps * mag;
+    ax.inv[a] = 1.0 / d;
+    ax.divide[a] = !std::isnormal(ax.inv[a]);
+    ax.tol[a] = d == 0 ? 0 : ax.divide[a] ? ax.tolPos[a] / std::fabs(d) : ax.tolPos[a] * std::fabs(ax.inv[a]);
+  }
+  // Divided by the largest component rather than the length (no square root): at most sqrt(3) times larger, and a
+  // larger slack only makes the stop rule more careful.
+  const Vec3& d = ray.direction;
+  const double dirMax = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
+  ax.hitSlack = (kCellSlack * cells.minCell + 64 * kEps * scale) / dirMax;
+  return ax;
+}
+
+bool gridSpan(const CellBoundaries& cells, const Ray& ray, const RayAxes& ax, double& tLo, double& tHi,
+              int& entryAxis) {
+  // Slab test against the closed grid box [b(0), b(n)].
+  tLo = ray.tMin;
+  tHi = ray.tMax;
+  entryAxis = -1;
+  for (int a = 0; a < 3; ++a) {
+    const double o = ray.origin[a], d = ray.direction[a];
+    const double gridLo = cells.b[a].front(), gridHi = cells.b[a].back();
+    if (d == 0) {
+      if (o < gridLo || o > gridHi) return false;
+      continue;
+    }
+    double t0 = ax.crossing(a, gridLo, o, d);
+    double t1 = ax.crossing(a, gridHi, o, d);
+    if (t0 > t1) std::swap(t0, t1);
+    t0 -= ax.tol[a] + kRel * std::fabs(t0);
+    t1 += ax.tol[a] + kRel * std::fabs(t1);
+    if (t0 > tLo) {
+      tLo = t0;
+      entryAxis = a;
+    }
+    tHi = std::min(tHi, t1);
+  }
+  return tLo <= tHi;
+}
+
 void GridWalker::init(const CellBoundaries& cells, const Ray& ray) {
   done_ = true;
   for (int a = 0; a < 3; ++a) {
@@ -50,42 +96,10 @@ void GridWalker::init(const CellBoundaries& cells, const Ray& ray) {
   if (ray.direction.x == 0 && ray.direction.y == 0 && ray.direction.z == 0) return;
   if (dims_[0] == 0 || dims_[1] == 0 || dims_[2] == 0) return;
 
-  double scale = 0;
-  for (int a = 0; a < 3; ++a) {
-    const double mag = std::fabs(org_[a]) + cells.magnitude[a];
-    scale = std::max(scale, mag);
-    // Positional slack per axis: a fraction of the cell plus the rounding of coordinates of this magnitude.
-    tolPos_[a] = kCellSlack * cells.cellSize[a] + 64 * kEps * mag;
-    inv_[a] = 1.0 / dir_[a];
-    divide_[a] = !std::isnormal(inv_[a]);
-    tol_[a] = dir_[a] == 0 ? 0 : divide_[a] ? tolPos_[a] / std::fabs(dir_[a]) : tolPos_[a] * std::fabs(inv_[a]);
-  }
-  // Divided by the largest component rather than the length (no square root): at most sqrt(3) times larger, and a
-  // larger slack only makes the stop rule more careful.
-  const double dirMax = std::max({std::fabs(dir_[0]), std::fabs(dir_[1]), std::fabs(dir_[2])});
-  hitSlack_ = (kCellSlack * cells.minCell + 64 * kEps * scale) / dirMax;
-
-  // Slab test against the closed grid box [b(0), b(n)].
-  double tLo = ray.tMin, tExitBox = ray.tMax;
-  int entry = -1;
-  for (int a = 0; a < 3; ++a) {
-    const double gridLo = bnd_[a][0], gridHi = bnd_[a][dims_[a]];
-    if (dir_[a] == 0) {
-      if (org_[a] < gridLo || org_[a] > gridHi) return;
-      continue;
-    }
-    double t0 = divide_[a] ? (gridLo - org_[a]) / dir_[a] : (gridLo - org_[a]) * inv_[a];
-    double t1 = divide_[a] ? (gridHi - org_[a]) / dir_[a] : (gridHi - org_[a]) * inv_[a];
-    if (t0 > t1) std::swap(t0, t1);
-    t0 -= tol_[a] + kRel * std::fabs(t0);
-    t1 += tol_[a] + kRel * std::fabs(t1);
-    if (t0 > tLo) {
-      tLo = t0;
-      entry = a;
-    }
-    tExitBox = std::min(tExitBox, t1);
-  }
-  if (!(tLo <= tExitBox)) return;
+  ax_ = rayAxes(cells, ray);
+  double tLo, tExitBox;
+  int entry;
+  if (!gridSpan(cells, ray, ax_, tLo, tExitBox, entry)) return;
   tHi_ = ray.tMax + hitSlack(ray.tMax);
 
   // The start cell, from the point at tLo. Each index is biased against the direction of travel by the positional
@@ -94,10 +108,10 @@ void GridWalker::init(const CellBoundaries& cells, const Ray& ray) {
   for (int a = 0; a < 3; ++a) {
     const double p = dir_[a] == 0 ? org_[a] : org_[a] + tLo * dir_[a];
     if (dir_[a] > 0) {
-      idx_[a] = cellBelow(cells, a, p - tolPos_[a]);
+      idx_[a] = cellBelow(cells, a, p - ax_.tolPos[a]);
       step_[a] = 1;
     } else if (dir_[a] < 0) {
-      idx_[a] = cellAbove(cells, a, p + tolPos_[a]);
+      idx_[a] = cellAbove(cells, a, p + ax_.tolPos[a]);
       step_[a] = -1;
     } else {
       idx_[a] = cellBelow(cells, a, p);
@@ -154,7 +168,7 @@ void GridWalker::fastForward() {
     }
     far[a] = step_[a] > 0 ? std::min<int64_t>((idx_[a] | mask) + 1, int64_t(dims_[a])) : (idx_[a] & ~mask);
     const double b = bnd_[a][far[a]];
-    tB[a] = divide_[a] ? (b - org_[a]) / dir_[a] : (b - org_[a]) * inv_[a];
+    tB[a] = ax_.crossing(a, b, org_[a], dir_[a]);
   }
   int m = 0;
   if (tB[1] < tB[m]) m = 1;
@@ -163,9 +177,9 @@ void GridWalker::fastForward() {
   if (!std::isfinite(tX)) return;
   for (int a = 0; a < 3; ++a)
     if (a != m && std::isfinite(tB[a]) &&
-        (tB[a] - tX) * std::fabs(dir_[a]) <= 2 * (tolPos_[a] + kRel * std::fabs(tX * dir_[a])))
+        (tB[a] - tX) * std::fabs(dir_[a]) <= 2 * (ax_.tolPos[a] + kRel * std::fabs(tX * dir_[a])))
       return;
-  const double T = tX - 2 * (tol_[m] + kRel * std::fabs(tX));
+  const double T = tX - 2 * (ax_.tol[m] + kRel * std::fabs(tX));
   for (int a = 0; a < 3; ++a) {
     if (step_[a] == 0) continue;
     while (idx_[a] + (step_[a] > 0 ? 1 : 0) != far[a] && tNext_[a] < T) {
@@ -198,17 +212,10 @@ struct Mailbox {
   }
 };
 
-inline bool testPrim(const Accel& accel, uint32_t id, const Ray& ray, double& t) {
-  if (id < accel.triangleCount) return intersectTriangle(accel.triangles[id], ray, t);
-  const uint32_t s = id - accel.triangleCount;
-  if (s < accel.sphereCount) return intersectSphere(accel.spheres[s], ray, t);
-  return intersectPlane(accel.planes[s - accel.sphereCount], ray, t);
-}
-
 inline void consider(const Accel& accel, uint32_t id, const Ray& ray, Hit& best, TraceStats& st) {
   double t;
   ++st.tests;
-  if (testPrim(accel, id, ray, t) && closer(t, id, best)) {
+  if (intersectPrimitive(accel, id, ray, t) && closer(t, id, best)) {
     best.t = t;
     best.prim = id;
   }
@@ -258,12 +265,12 @@ bool occluded(const Accel& accel, const Ray& ray, TraceStats* stats) {
     const uint32_t n = accel.primitiveCount();
     for (uint32_t id = 0; id < n && !hit; ++id) {
       ++st.tests;
-      hit = testPrim(accel, id, ray, t);
+      hit = intersectPrimitive(accel, id, ray, t);
     }
   } else {
     for (size_t i = 0; i < accel.alwaysTested.size() && !hit; ++i) {
       ++st.tests;
-      hit = testPrim(accel, accel.alwaysTested[i], ray, t);
+      hit = intersectPrimitive(accel, accel.alwaysTested[i], ray, t);
     }
     GridWalker walker(accel, ray);
     Mailbox mailbox;
@@ -278,7 +285,7 @@ bool occluded(const Accel& accel, const Ray& ray, TraceStats* stats) {
           continue;
         }
         ++st.tests;
-        if (testPrim(accel, id, ray, t)) {
+        if (intersectPrimitive(accel, id, ray, t)) {
           hit = true;
           break;
         }

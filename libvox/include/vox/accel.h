@@ -79,6 +79,14 @@ struct Accel {
   std::span<const uint32_t> cellPrims(uint32_t occupiedIndex) const { return grid->cellPrims(occupiedIndex); }
 };
 
+// The ray test of primitive `id` (any kind), as every traversal calls it.
+inline bool intersectPrimitive(const Accel& accel, uint32_t id, const Ray& ray, double& t) {
+  if (id < accel.triangleCount) return intersectTriangle(accel.triangles[id], ray, t);
+  const uint32_t s = id - accel.triangleCount;
+  if (s < accel.sphereCount) return intersectSphere(accel.spheres[s], ray, t);
+  return intersectPlane(accel.planes[s - accel.sphereCount], ray, t);
+}
+
 // Prepares every primitive of `scene` and the cell lookup of `grid` (which must have been built from `scene`; the
 // Accel keeps a pointer to it). Throws InputError when the grid names primitive ids that
 // the scene does not have, vox::Error for a singular ellipsoid transform, LimitError when the grid has 2^32 - 2 or

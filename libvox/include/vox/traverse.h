@@ -25,6 +25,34 @@
 
 namespace vox {
 
+// Tolerances of the walk (docs/trace.md), shared by the single-ray walker and the packet traversal.
+inline constexpr double kWalkRel = 16 * std::numeric_limits<double>::epsilon();  // relative slack on any t
+// Fraction of a cell by which boundaries are treated as fuzzy: rays passing this close to an edge or corner also
+// visit the cells across it. Costs an extra cell visit about once per million crossings.
+inline constexpr double kCellSlack = 1e-6;
+
+// The per-axis constants of one ray's walk.
+struct RayAxes {
+  double inv[3];      // 1 / d
+  bool divide[3];     // 1 / d is not a normal number: divide by d instead of multiplying by inv
+  double tolPos[3];   // positional tolerance of each axis in world units
+  double tol[3];      // the same in ray parameter units (0 for a zero component)
+  double hitSlack;    // bound on the error of a primitive hit's t, without the part relative to t
+
+  // The parameter at which the ray crosses the plane x_a = b: (b - o) * (1 / d) when 1 / d is a normal number (a
+  // multiplication instead of a division per step; error at most 2 ulps more than the quotient, far inside kWalkRel),
+  // else (b - o) / d. Only for a nonzero d.
+  double crossing(int a, double b, double o, double d) const { return divide[a] ? (b - o) / d : (b - o) * inv[a]; }
+  // Bound on the error of a primitive hit's t at parameter t, used to decide when a walk may stop.
+  double hitSlackAt(double t) const { return hitSlack + 1e-9 * std::fabs(t); }
+};
+RayAxes rayAxes(const CellBoundaries& cells, const Ray& ray);
+
+// The parameters [tLo, tHi] within which `ray` (finite, nonzero direction, restricted to [tMin, tMax]) can be inside
+// the closed grid box, widened by the tolerances; `entryAxis` is the axis whose slab sets tLo (-1 when tMin does).
+// False when the ray misses the box.
+bool gridSpan(const CellBoundaries& cells, const Ray& ray, const RayAxes& ax, double& tLo, double& tHi, int& entryAxis);
+
 struct WalkCell {
   std::array<uint32_t, 3> idx;
   double tEnter = 0, tExit = 0;
@@ -83,39 +111,32 @@ class GridWalker {
     const int m = t2 < t01 ? 2 : m01;
     const double tm = t2 < t01 ? t2 : t01;
     out.tExit = tm;
-    out.exitSlack = tol_[m] + kRel * std::fabs(tm);
+    out.exitSlack = ax_.tol[m] + kRel * std::fabs(tm);
     step(m, tm, out);
     return true;
   }
 
   // Bound on the error of a primitive hit's t at parameter t (ray units), used to decide when the walk may stop.
-  double hitSlack(double t) const { return hitSlack_ + 1e-9 * std::fabs(t); }
+  double hitSlack(double t) const { return ax_.hitSlackAt(t); }
   uint64_t stepsTaken() const { return steps_; }
 
-  // The parameter at which the ray crosses the plane x_axis = b, as the walker computes it for cell exits:
-  // (b - o) * (1 / d) when 1 / d is a normal number (a multiplication instead of a division per step; error at most
-  // 2 ulps more than the quotient, far inside the slack kRel), else (b - o) / d. Only for a nonzero d.
-  static double crossing(double b, double o, double d) {
-    const double inv = 1.0 / d;
-    return std::isnormal(inv) ? (b - o) * inv : (b - o) / d;
-  }
 
  private:
-  static constexpr double kRel = 16 * std::numeric_limits<double>::epsilon();
+  static constexpr double kRel = kWalkRel;
 
   void init(const CellBoundaries& cells, const Ray& ray);
   double nextT(int a) const {
     if (step_[a] == 0) return std::numeric_limits<double>::infinity();
     const double b = bnd_[a][idx_[a] + (step_[a] > 0 ? 1 : 0)];
-    return divide_[a] ? (b - org_[a]) / dir_[a] : (b - org_[a]) * inv_[a];
+    return ax_.crossing(a, b, org_[a], dir_[a]);
   }
   // Is the ray, at parameter tm, within tolerance of axis a's next boundary?
   bool near(int a, double tm) const {
-    return std::isfinite(tNext_[a]) && (tNext_[a] - tm) * std::fabs(dir_[a]) <= tolPos_[a] + kRel * std::fabs(tm * dir_[a]);
+    return std::isfinite(tNext_[a]) && (tNext_[a] - tm) * std::fabs(dir_[a]) <= ax_.tolPos[a] + kRel * std::fabs(tm * dir_[a]);
   }
 
   void step(int m, double tm, const WalkCell& from) {
-    if (!(tm <= tHi_ + tol_[m] + kRel * std::fabs(tm)) || ++steps_ > maxSteps_) {
+    if (!(tm <= tHi_ + ax_.tol[m] + kRel * std::fabs(tm)) || ++steps_ > maxSteps_) {
       done_ = true;
       return;
     }
@@ -146,15 +167,12 @@ class GridWalker {
   std::unique_ptr<CellBoundaries> owned_;  // the tables, when the walker built them itself
   const double* bnd_[3] = {nullptr, nullptr, nullptr};
   uint64_t dims_[3] = {0, 0, 0};
-  double org_[3], dir_[3], inv_[3];
-  bool divide_[3] = {false, false, false};  // 1 / d is not a normal number: divide instead
+  double org_[3], dir_[3];
+  RayAxes ax_{};
   int64_t idx_[3] = {0, 0, 0};
   int64_t step_[3] = {0, 0, 0};
   double tNext_[3];
-  double tol_[3];     // positional tolerance of each axis in ray parameter units (0 for a zero component)
-  double tolPos_[3];  // positional tolerance of each axis in world units
   double tCur_ = 0, tHi_ = 0;
-  double hitSlack_ = 0;
   int entryAxis_ = -1;
   bool done_ = true;
   uint64_t steps_ = 0, maxSteps_ = 0;

@@ -1,0 +1,322 @@
+// Slice-by-slice packet traversal (trace_packet.h). Why it returns exactly what traceRay returns, for every ray:
+// - The nearest hit of a ray lies in a cell the ray passes through, and (exact, sat, bbox grids) its primitive is in
+//   that cell. Each slice's rectangle holds every cell of the slice that any still-walking ray of the packet can
+//   touch: the rays' positions in the slab are bounded by interval arithmetic on a + c s (a, s per ray, c across
+//   the slab), widened by the walker's positional tolerance and a bound on the rounding of that arithmetic.
+// - Every primitive found there is tested with the same arithmetic as the scalar test (triangle_kernel.h) and kept
+//   by the same order (closer()), so extra primitives change nothing: the minimum over a superset holding the
+//   nearest hit is the nearest hit.
+// - A ray stops walking after a slice when its best hit, widened by the walker's hit slack, lies before the next
+//   slice's boundary, narrowed by the walker's exit slack: the stop rule of traceRay.
+#include "vox/trace_packet.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+// The vector kernel is always inlined into triangleLanes, so GCC's note that passing 32-byte vectors without AVX
+// changes the calling convention concerns no real call.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+#include "cell_range.h"
+#include "triangle_kernel.h"
+#include "vox/error.h"
+
+namespace vox {
+
+namespace {
+
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// Largest slice rectangle, in cells per walking ray, worth visiting as a packet (a ray alone visits 1 to 3 cells
+// per slice, each at several times the cost of a rectangle cell).
+constexpr uint64_t kMaxCellsPerLane = 4;
+
+// The rays of the packet that are still walking, as a structure of arrays, so that one triangle is tested against
+// all of them in vector registers.
+struct Lanes {
+  alignas(64) double ox[kMaxPacketRays], oy[kMaxPacketRays], oz[kMaxPacketRays];
+  alignas(64) double dx[kMaxPacketRays], dy[kMaxPacketRays], dz[kMaxPacketRays];
+  alignas(64) double tMin[kMaxPacketRays], tMax[kMaxPacketRays];
+  alignas(64) double t[kMaxPacketRays];  // result of the last test: the hit's t, NaN for a miss
+  uint32_t ray[kMaxPacketRays];          // index of the lane's ray in the packet
+  uint32_t count = 0;
+
+  void add(uint32_t r, const Ray& ray) {
+    const uint32_t j = count++;
+    ox[j] = ray.origin.x, oy[j] = ray.origin.y, oz[j] = ray.origin.z;
+    dx[j] = ray.direction.x, dy[j] = ray.direction.y, dz[j] = ray.direction.z;
+    tMin[j] = ray.tMin, tMax[j] = ray.tMax;
+    this->ray[j] = r;
+  }
+  void remove(uint32_t j) {
+    const uint32_t e = --count;
+    ox[j] = ox[e], oy[j] = oy[e], oz[j] = oz[e], dx[j] = dx[e], dy[j] = dy[e], dz[j] = dz[e];
+    tMin[j] = tMin[e], tMax[j] = tMax[e], ray[j] = ray[e];
+  }
+};
+
+// One triangle against every lane, four at a time. Compiled twice, for AVX2 and for the baseline, and picked at
+// load time: the arithmetic is IEEE double either way (no contraction), so both give the scalar test's t. Lanes past
+// `count` hold zeros or retired rays; their results are never read. Returns the lanes hit, as bits.
+__attribute__((target_clones("avx2", "default"))) uint64_t triangleLanes(const TriangleData& tri, Lanes& lanes) {
+  using kernel::Double4;
+  const double v0[3] = {tri.v0.x, tri.v0.y, tri.v0.z}, e1[3] = {tri.e1.x, tri.e1.y, tri.e1.z},
+               e2[3] = {tri.e2.x, tri.e2.y, tri.e2.z}, n[3] = {tri.n.x, tri.n.y, tri.n.z};
+  const Double4 nan = {kNaN, kNaN, kNaN, kNaN};
+  uint64_t bits = 0;
+  for (uint32_t j = 0; j < lanes.count; j += 4) {
+    Double4 ox, oy, oz, dx, dy, dz, tMin, tMax, t;
+    __builtin_memcpy(&ox, lanes.ox + j, sizeof(ox));
+    __builtin_memcpy(&oy, lanes.oy + j, sizeof(oy));
+    __builtin_memcpy(&oz, lanes.oz + j, sizeof(oz));
+    __builtin_memcpy(&dx, lanes.dx + j, sizeof(dx));
+    __builtin_memcpy(&dy, lanes.dy + j, sizeof(dy));
+    __builtin_memcpy(&dz, lanes.dz + j, sizeof(dz));
+    __builtin_memcpy(&tMin, lanes.tMin + j, sizeof(tMin));
+    __builtin_memcpy(&tMax, lanes.tMax + j, sizeof(tMax));
+    const auto hit = kernel::triangleHit(v0, e1, e2, n, ox, oy, oz, dx, dy, dz, tMin, tMax, t);
+    const Double4 result = hit ? t : nan;
+    __builtin_memcpy(lanes.t + j, &result, sizeof(result));
+    bits |= uint64_t((hit[0] & 1) | (hit[1] & 2) | (hit[2] & 4) | (hit[3] & 8)) << j;
+  }
+  const uint64_t live = lanes.count == 64 ? ~uint64_t(0) : (uint64_t(1) << lanes.count) - 1;
+  return bits & live;
+}
+
+// A direct-mapped set of the primitives this packet has tested. A collision only repeats a test, whose result is
+// then not closer() than what it already gave.
+struct PacketMailbox {
+  static constexpr uint32_t kSize = 512;
+  uint32_t ids[kSize];
+  PacketMailbox() { std::memset(ids, 0xff, sizeof(ids)); }
+  bool seen(uint32_t id) {
+    uint32_t& slot = ids[id & (kSize - 1)];
+    if (slot == id) return true;
+    slot = id;
+    return false;
+  }
+};
+
+// The axis along which the packet is sliced: the first ray's largest direction component, provided every ray is
+// finite and travels the same way along it with a slope of at most 2 in the other axes. -1 when there is none (the
+// rays are then traced one by one).
+int sliceAxis(const Accel& accel, std::span<const Ray> rays) {
+  const CellBoundaries& cb = accel.boundaries;
+  if (accel.kind != AccelKind::Grid || rays.size() < 2 || cb.dims[0] == 0 || cb.dims[1] == 0 || cb.dims[2] == 0)
+    return -1;
+  const Vec3& d0 = rays[0].direction;
+  int k = 0;
+  if (std::fabs(d0.y) > std::fabs(d0[k])) k = 1;
+  if (std::fabs(d0.z) > std::fabs(d0[k])) k = 2;
+  const bool forward = d0[k] > 0;
+  for (const Ray& ray : rays) {
+    if (!isFinite(ray.origin) || !isFinite(ray.direction) || std::isnan(ray.tMin) || std::isnan(ray.tMax)) return -1;
+    const double dk = ray.direction[k];
+    if (dk == 0 || (dk > 0) != forward) return -1;
+    const double other = std::max(std::fabs(ray.direction[(k + 1) % 3]), std::fabs(ray.direction[(k + 2) % 3]));
+    if (!(std::fabs(dk) >= 0.5 * other)) return -1;
+  }
+  return k;
+}
+
+// Where the rays of the packet can be on one of the other axes while crossing a slab: every ray is a + c s there
+// (c the slab coordinate relative to the packet's reference, a and s per ray), so an interval bound over the rays
+// and over c in the slab bounds them all.
+struct AxisBounds {
+  double aLo = 0, aHi = 0, sLo = 0, sHi = 0;
+  double magnitude = 0;  // largest |a| + |o| + |c0 - o_k| |s| of any ray: scales the rounding of a and of a + c s
+  double sMax = 0;       // largest |s|
+  double tolPos = 0;     // the walker's positional tolerance on this axis, for the largest origin coordinate
+
+  // The cells of this axis that the rays can touch for c in [cA, cB] (relative to the reference).
+  std::array<int64_t, 3> cells(const CellBoundaries& cb, int axis, double cA, double cB) const {
+    const double p0 = cA * sLo, p1 = cA * sHi, p2 = cB * sLo, p3 = cB * sHi;
+    const double lo = aLo + std::min({p0, p1, p2, p3}), hi = aHi + std::max({p0, p1, p2, p3});
+    const double pad = tolPos + 64 * kEps * (magnitude + std::max(std::fabs(cA), std::fabs(cB)) * sMax);
+    const double* b = cb.b[axis].data();
+    const auto r = cellRangeOnAxis(int64_t(cb.dims[axis]), cb.cellsPerUnit[axis], [b](int64_t i) { return b[i]; },
+                                   lo - pad, hi + pad);
+    return {r[0], r[1], 0};
+  }
+};
+
+// What a lane needs of its ray besides the lane arrays: the slab position (a, s) on the other two axes, and the
+// walker's tolerances on the slice axis k.
+struct RayState {
+  double a[2], s[2];
+  double invK;      // 1 / d_k
+  bool divideK;     // 1 / d_k is not a normal number: divide by d_k instead (as RayAxes::crossing)
+  double tolK;      // RayAxes::tol[k]
+  double hitSlack;  // at least RayAxes::hitSlack: divided by |d_k| instead of the largest |d|
+  double tEnd;      // tMax widened by the hit slack, as the walker's last parameter
+
+  double crossingK(double b, double o, double d) const { return divideK ? (b - o) / d : (b - o) * invK; }
+};
+
+void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<Hit> hits, TraceStats* stats) {
+  const int k = sliceAxis(accel, rays);
+  if (k < 0) {
+    for (size_t r = 0; r < rays.size(); ++r) hits[r] = traceRay(accel, rays[r], stats);
+    return;
+  }
+  const int other[2] = {(k + 1) % 3, (k + 2) % 3};
+  const CellBoundaries& cb = accel.boundaries;
+  const int64_t nk = cb.dims[k];
+  const double* bk = cb.b[k].data();
+  const bool forward = rays[0].direction[k] > 0;
+  const double c0 = rays[0].origin[k];
+  const uint32_t n = uint32_t(rays.size());
+
+  TraceStats st;
+  st.rays = n;
+  RayState state[kMaxPacketRays];
+  Hit best[kMaxPacketRays];
+  Lanes lanes{};
+  AxisBounds bounds[2];
+  double originMax[3] = {0, 0, 0};
+  // The span of slab coordinates the rays cover within [tMin, tEnd].
+  double pLo = kInfinity, pHi = -kInfinity;
+  for (uint32_t r = 0; r < n; ++r) {
+    const Ray& ray = rays[r];
+    best[r] = Hit{};
+    for (uint32_t id : accel.alwaysTested) {
+      double t;
+      ++st.tests;
+      if (intersectPrimitive(accel, id, ray, t) && closer(t, id, best[r])) best[r] = {t, id};
+    }
+    RayState& rs = state[r];
+    const double dk = ray.direction[k], ok = ray.origin[k];
+    rs.invK = 1.0 / dk;
+    rs.divideK = !std::isnormal(rs.invK);
+    const double absInv = rs.divideK ? 1.0 / std::fabs(dk) : std::fabs(rs.invK);
+    const double tolPosK = kCellSlack * cb.cellSize[k] + 64 * kEps * (std::fabs(ok) + cb.magnitude[k]);
+    rs.tolK = rs.divideK ? tolPosK / std::fabs(dk) : tolPosK * absInv;
+    double scale = 0;
+    for (int a = 0; a < 3; ++a) scale = std::max(scale, std::fabs(ray.origin[a]) + cb.magnitude[a]);
+    rs.hitSlack = (kCellSlack * cb.minCell + 64 * kEps * scale) * absInv;
+    rs.tEnd = ray.tMax + (rs.hitSlack + 1e-9 * std::fabs(ray.tMax));
+    const double pStart = ok + ray.tMin * dk, pEnd = ok + rs.tEnd * dk;
+    pLo = std::min({pLo, pStart, pEnd});
+    pHi = std::max({pHi, pStart, pEnd});
+    for (double p : {pStart, pEnd})
+      if (std::isfinite(p)) originMax[k] = std::max(originMax[k], std::fabs(p));
+    const double shift = c0 - ok;
+    for (int q = 0; q < 2; ++q) {
+      const int u = other[q];
+      rs.s[q] = rs.divideK ? ray.direction[u] / dk : ray.direction[u] * rs.invK;
+      rs.a[q] = ray.origin[u] + shift * rs.s[q];
+      bounds[q].magnitude = std::max(bounds[q].magnitude, std::fabs(rs.a[q]) + std::fabs(ray.origin[u]) +
+                                                              std::fabs(shift) * std::fabs(rs.s[q]));
+      bounds[q].sMax = std::max(bounds[q].sMax, std::fabs(rs.s[q]));
+      originMax[u] = std::max(originMax[u], std::fabs(ray.origin[u]));
+    }
+    lanes.add(r, ray);
+  }
+  for (int q = 0; q < 2; ++q) {
+    const int u = other[q];
+    bounds[q].tolPos = kCellSlack * cb.cellSize[u] + 64 * kEps * (originMax[u] + cb.magnitude[u]);
+  }
+  // Slices to walk, in order of travel: from `first` to `last`.
+  const double padK = kCellSlack * cb.cellSize[k] + 64 * kEps * (originMax[k] + cb.magnitude[k]);
+  const auto range = cellRangeOnAxis(nk, cb.cellsPerUnit[k], [bk](int64_t i) { return bk[i]; }, pLo - padK, pHi + padK);
+  if (range[0] > range[1]) lanes.count = 0;
+  const int64_t first = forward ? range[0] : range[1], last = forward ? range[1] : range[0];
+
+  PacketMailbox mailbox;
+  bool boundsStale = true;
+  const int64_t step = forward ? 1 : -1;
+  for (int64_t slice = first; lanes.count > 0; slice += step) {
+    if (boundsStale) {
+      for (int q = 0; q < 2; ++q) {
+        AxisBounds& ab = bounds[q];
+        const RayState& s0 = state[lanes.ray[0]];
+        ab.aLo = ab.aHi = s0.a[q];
+        ab.sLo = ab.sHi = s0.s[q];
+        for (uint32_t j = 1; j < lanes.count; ++j) {
+          const RayState& rs = state[lanes.ray[j]];
+          ab.aLo = std::min(ab.aLo, rs.a[q]), ab.aHi = std::max(ab.aHi, rs.a[q]);
+          ab.sLo = std::min(ab.sLo, rs.s[q]), ab.sHi = std::max(ab.sHi, rs.s[q]);
+        }
+      }
+      boundsStale = false;
+    }
+    const double cA = bk[slice] - c0, cB = bk[slice + 1] - c0;
+    const auto ru = bounds[0].cells(cb, other[0], cA, cB);
+    const auto rv = bounds[1].cells(cb, other[1], cA, cB);
+    if (ru[0] > ru[1] || rv[0] > rv[1]) {
+      // Nothing here: has the packet left the grid for good?
+      const double cEnd = (forward ? bk[last + 1] : bk[last]) - c0;
+      const auto restU = bounds[0].cells(cb, other[0], cA, cEnd), restV = bounds[1].cells(cb, other[1], cA, cEnd);
+      if (restU[0] > restU[1] || restV[0] > restV[1]) break;
+    }
+    // A packet wide compared with the cells (a large grid, a wide tile, rays diverging far from the camera) would
+    // visit more cells per slice than its rays walking alone: let them walk alone from here. traceRay starts each
+    // ray afresh, so its answer is the same whatever this packet found so far.
+    if (ru[0] <= ru[1] && rv[0] <= rv[1] &&
+        uint64_t(ru[1] - ru[0] + 1) * uint64_t(rv[1] - rv[0] + 1) > kMaxCellsPerLane * lanes.count + 8) {
+      for (uint32_t l = 0; l < lanes.count; ++l) best[lanes.ray[l]] = traceRay(accel, rays[lanes.ray[l]], &st);
+      st.rays -= lanes.count;
+      break;
+    }
+    uint32_t idx[3];
+    idx[k] = uint32_t(slice);
+    for (int64_t j = rv[0]; j <= rv[1]; ++j) {
+      idx[other[1]] = uint32_t(j);
+      for (int64_t i = ru[0]; i <= ru[1]; ++i) {
+        idx[other[0]] = uint32_t(i);
+        ++st.cells;
+        const uint32_t c = accel.lookup(idx[0], idx[1], idx[2]);
+        if (c >= kSolidCell) continue;
+        for (uint32_t id : accel.cellPrims(c)) {
+          if (mailbox.seen(id)) {
+            st.mailboxSkips += lanes.count;
+            continue;
+          }
+          st.tests += lanes.count;
+          uint64_t hitBits = 0;
+          if (id < accel.triangleCount) {
+            hitBits = triangleLanes(accel.triangles[id], lanes);
+          } else {
+            for (uint32_t l = 0; l < lanes.count; ++l)
+              if (intersectPrimitive(accel, id, rays[lanes.ray[l]], lanes.t[l])) hitBits |= uint64_t(1) << l;
+          }
+          for (; hitBits != 0; hitBits &= hitBits - 1) {
+            const uint32_t l = uint32_t(__builtin_ctzll(hitBits));
+            Hit& h = best[lanes.ray[l]];
+            if (closer(lanes.t[l], id, h)) h = {lanes.t[l], id};
+          }
+        }
+      }
+    }
+    if (slice == last) break;
+    // Retire the rays that cannot meet anything nearer in the slices to come, or whose walk ends before them.
+    const double boundary = forward ? bk[slice + 1] : bk[slice];
+    for (uint32_t l = lanes.count; l-- > 0;) {
+      const uint32_t r = lanes.ray[l];
+      const RayState& rs = state[r];
+      const double tCross = rs.crossingK(boundary, rays[r].origin[k], rays[r].direction[k]);
+      const double tNextMin = tCross - (rs.tolK + kWalkRel * std::fabs(tCross));
+      const Hit& h = best[r];
+      if (tNextMin > rs.tEnd || (h.valid() && h.t + (rs.hitSlack + 1e-9 * std::fabs(h.t)) < tNextMin)) {
+        lanes.remove(l);
+        boundsStale = true;
+      }
+    }
+  }
+  for (uint32_t r = 0; r < n; ++r) hits[r] = best[r];
+  if (stats) *stats += st;
+}
+
+}  // namespace
+
+void tracePacket(const Accel& accel, std::span<const Ray> rays, std::span<Hit> hits, TraceStats* stats) {
+  if (hits.size() < rays.size()) fail<Error>("tracePacket: ", rays.size(), " rays but room for ", hits.size(), " hits");
+  for (size_t begin = 0; begin < rays.size(); begin += kMaxPacketRays) {
+    const size_t count = std::min<size_t>(kMaxPacketRays, rays.size() - begin);
+    tracePacketChunk(accel, rays.subspan(begin, count), hits.subspan(begin, count), stats);
+  }
+}
+
+}  // namespace vox

@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "vox/error.h"
+#include "vox/trace_packet.h"
 
 #if __has_include("vox/colormap.h")
 #include "vox/colormap.h"
@@ -196,29 +197,20 @@ struct Renderer {
     return color;
   }
 
-  // One sample; writes `channels` values into out.
-  void sample(const Ray& ray, float* out, TraceStats& st) const {
+  // Modes whose samples are the nearest hit of the primary ray: those are traced in packets.
+  bool nearestHitMode() const {
+    return options.mode == RenderMode::Shade || options.mode == RenderMode::Normals || options.mode == RenderMode::Depth;
+  }
+
+  // One sample of a nearest-hit mode from its hit; writes `channels` values into out.
+  void fromHit(const Ray& ray, const Hit& hit, float* out, TraceStats& st) const {
     switch (options.mode) {
       case RenderMode::Shade: {
-        const Hit hit = traceRay(accel, ray, &st);
         const Vec3 c = hit.valid() ? shade(ray, hit, st) : scene.background;
         out[0] = float(c.x), out[1] = float(c.y), out[2] = float(c.z);
         break;
       }
-      case RenderMode::Voxels: {
-        const CellHit cell = firstOccupiedCell(accel, ray, &st);
-        const Vec3 c = cell.hit ? shadeVoxel(ray, cell) : scene.background;
-        out[0] = float(c.x), out[1] = float(c.y), out[2] = float(c.z);
-        break;
-      }
-      case RenderMode::Count: {
-        const uint64_t before = st.cells;
-        traceRay(accel, ray, &st);
-        out[0] = float(st.cells - before);
-        break;
-      }
       case RenderMode::Normals: {
-        const Hit hit = traceRay(accel, ray, &st);
         Vec3 c;
         if (hit.valid()) {
           Vec3 n = normalOf(accel, ray, hit);
@@ -228,11 +220,24 @@ struct Renderer {
         out[0] = float(c.x), out[1] = float(c.y), out[2] = float(c.z);
         break;
       }
-      case RenderMode::Depth: {
-        const Hit hit = traceRay(accel, ray, &st);
+      case RenderMode::Depth:
         out[0] = hit.valid() ? float(hit.t * length(ray.direction)) : 0.0f;
         break;
-      }
+      default:
+        break;
+    }
+  }
+
+  // One sample of the voxels or count mode.
+  void walkSample(const Ray& ray, float* out, TraceStats& st) const {
+    if (options.mode == RenderMode::Voxels) {
+      const CellHit cell = firstOccupiedCell(accel, ray, &st);
+      const Vec3 c = cell.hit ? shadeVoxel(ray, cell) : scene.background;
+      out[0] = float(c.x), out[1] = float(c.y), out[2] = float(c.z);
+    } else {
+      const uint64_t before = st.cells;
+      traceRay(accel, ray, &st);
+      out[0] = float(st.cells - before);
     }
   }
 };
@@ -271,27 +276,47 @@ Image traceImage(const Scene& scene, const Accel& accel, const RenderOptions& op
       tbb::blocked_range2d<uint32_t>(0, image.height, kTile, 0, image.width, kTile),
       [&](const tbb::blocked_range2d<uint32_t>& tile) {
         TraceStats& st = perThread.local();
-        float value[3];
-        for (uint32_t y = tile.rows().begin(); y < tile.rows().end(); ++y) {
-          for (uint32_t x = tile.cols().begin(); x < tile.cols().end(); ++x) {
-            float sum[3] = {0, 0, 0};
-            uint64_t rng = options.seed ^ ((uint64_t(y) << 32) | x) * 0x9e3779b97f4a7c15ull;
-            for (uint32_t s = 0; s < options.samples; ++s) {
-              double px = x + 0.5, py = y + 0.5;
-              if (options.samples > 1) {
-                if (stratified) {
-                  px = x + ((s % strata) + uniform(rng)) / strata;
-                  py = y + ((s / strata) + uniform(rng)) / strata;
-                } else {
-                  px = x + uniform(rng);
-                  py = y + uniform(rng);
-                }
+        // Blocks of 8x8 pixels: each sample index of a block is one packet of primary rays.
+        constexpr uint32_t kBlock = 8;
+        static_assert(kBlock * kBlock <= kMaxPacketRays);
+        for (uint32_t by = tile.rows().begin(); by < tile.rows().end(); by += kBlock) {
+          for (uint32_t bx = tile.cols().begin(); bx < tile.cols().end(); bx += kBlock) {
+            uint32_t px[kMaxPacketRays], py[kMaxPacketRays], count = 0;
+            uint64_t rng[kMaxPacketRays];
+            for (uint32_t y = by; y < std::min(by + kBlock, tile.rows().end()); ++y)
+              for (uint32_t x = bx; x < std::min(bx + kBlock, tile.cols().end()); ++x) {
+                px[count] = x, py[count] = y;
+                rng[count++] = options.seed ^ ((uint64_t(y) << 32) | x) * 0x9e3779b97f4a7c15ull;
               }
-              r.sample(rayFromFrame(options.camera, r.frame, image.width, image.height, px, py), value, st);
-              for (uint32_t c = 0; c < image.channels; ++c) sum[c] += value[c];
+            float sum[kMaxPacketRays][3] = {};
+            Ray rays[kMaxPacketRays];
+            Hit hits[kMaxPacketRays];
+            for (uint32_t s = 0; s < options.samples; ++s) {
+              for (uint32_t p = 0; p < count; ++p) {
+                double sx = px[p] + 0.5, sy = py[p] + 0.5;
+                if (options.samples > 1) {
+                  if (stratified) {
+                    sx = px[p] + ((s % strata) + uniform(rng[p])) / strata;
+                    sy = py[p] + ((s / strata) + uniform(rng[p])) / strata;
+                  } else {
+                    sx = px[p] + uniform(rng[p]);
+                    sy = py[p] + uniform(rng[p]);
+                  }
+                }
+                rays[p] = rayFromFrame(options.camera, r.frame, image.width, image.height, sx, sy);
+              }
+              if (r.nearestHitMode()) tracePacket(accel, {rays, count}, {hits, count}, &st);
+              for (uint32_t p = 0; p < count; ++p) {
+                float value[3];
+                if (r.nearestHitMode()) r.fromHit(rays[p], hits[p], value, st);
+                else r.walkSample(rays[p], value, st);
+                for (uint32_t c = 0; c < image.channels; ++c) sum[p][c] += value[c];
+              }
             }
-            float* out = image.at(x, y);
-            for (uint32_t c = 0; c < image.channels; ++c) out[c] = sum[c] / float(options.samples);
+            for (uint32_t p = 0; p < count; ++p) {
+              float* out = image.at(px[p], py[p]);
+              for (uint32_t c = 0; c < image.channels; ++c) out[c] = sum[p][c] / float(options.samples);
+            }
           }
         }
         if (options.progress && tile.cols().end() == image.width) {

@@ -140,7 +140,32 @@ struct AxisBounds {
                                    lo - pad, hi + pad);
     return {r[0], r[1], 0};
   }
+
+  // Whether the point at slab coordinate c (relative to the reference) and position p on this axis lies below every
+  // ray by more than the tolerance (-1), above every ray (+1), or neither (0). "Below" is the region under the
+  // concave bound aLo + min(c sLo, c sHi), a convex set, and "above" the region over the convex bound: a triangle
+  // whose three vertices are all below (or all above) lies there whole, and no ray of the packet can meet it.
+  int side(double c, double p) const {
+    const double pad = tolPos + 64 * kEps * (magnitude + std::fabs(c) * sMax + std::fabs(p));
+    const double cLo = c * sLo, cHi = c * sHi;
+    if (p < aLo + std::min(cLo, cHi) - pad) return -1;
+    if (p > aHi + std::max(cLo, cHi) + pad) return 1;
+    return 0;
+  }
 };
+
+// Frustum culling of a triangle against the packet (Wald et al. 2006): true when, on one of the two axes across the
+// slices, all three vertices lie on the same outer side of every ray.
+bool outsidePacket(const TriangleData& tri, int k, const int other[2], double c0, const AxisBounds bounds[2]) {
+  const Vec3 v[3] = {tri.v0, tri.v0 + tri.e1, tri.v0 + tri.e2};
+  for (int q = 0; q < 2; ++q) {
+    const int u = other[q];
+    const int s0 = bounds[q].side(v[0][k] - c0, v[0][u]);
+    if (s0 != 0 && bounds[q].side(v[1][k] - c0, v[1][u]) == s0 && bounds[q].side(v[2][k] - c0, v[2][u]) == s0)
+      return true;
+  }
+  return false;
+}
 
 // What a lane needs of its ray besides the lane arrays: the slab position (a, s) on the other two axes, and the
 // walker's tolerances on the slice axis k.
@@ -274,11 +299,14 @@ void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<H
             st.mailboxSkips += lanes.count;
             continue;
           }
-          st.tests += lanes.count;
           uint64_t hitBits = 0;
           if (id < accel.triangleCount) {
-            hitBits = triangleLanes(accel.triangles[id], lanes);
+            const TriangleData& tri = accel.triangles[id];
+            if (outsidePacket(tri, k, other, c0, bounds)) continue;
+            st.tests += lanes.count;
+            hitBits = triangleLanes(tri, lanes);
           } else {
+            st.tests += lanes.count;
             for (uint32_t l = 0; l < lanes.count; ++l)
               if (intersectPrimitive(accel, id, rays[lanes.ray[l]], lanes.t[l])) hitBits |= uint64_t(1) << l;
           }

@@ -1,9 +1,11 @@
-// Primary-ray throughput of the grid walk against Embree 3 on the same triangles, camera and thread count.
-//   bench_trace [--threads N] [--size N] [--factor F ...] [SCENE ...]
+// Primary-ray throughput of the grid against Embree 3 on the same triangles, camera and thread count.
+//   bench_trace [--threads N] [--size N] [--reps N] [--factor F ...] [SCENE ...]
 // Default scenes: the 40k seed bunny, the 69k Stanford bunny (PLY), the 115k SheenCloth. For each scene it voxelizes
-// (exact) at each cells-per-triangle factor, traces size x size primary rays from defaultCamera(bounds) with
-// vox::traceRay, rtcIntersect1 and rtcIntersect8 (coherent context, 4x2 pixel packets), best of three runs each, and
-// prints rays per second, the ratio ours / Embree, and how many pixels hit the same triangle.
+// (exact) at each cells-per-triangle factor and traces size x size primary rays from defaultCamera(bounds) with
+// rtcIntersect1, rtcIntersect8 (coherent context, 4x2 pixel packets), vox::traceRay (one ray at a time) and
+// vox::tracePacket (8x8 pixel packets, as vox-trace renders). The methods take turns, `reps` rounds, and each keeps
+// its best time, so that a burst of load on a shared machine hits them alike. Prints rays per second, the ratios
+// ours / Embree, cells and tests per ray, and how many pixels hit the same triangle as Embree and as traceRay.
 #include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
@@ -15,6 +17,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -29,15 +33,39 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-template <typename F>
-double bestSeconds(F&& f) {
+struct Method {
+  std::string name;
+  std::function<void()> run;
   double best = 1e30;
-  for (int r = 0; r < 3; ++r) {
-    const auto t0 = Clock::now();
-    f();
-    best = std::min(best, std::chrono::duration<double>(Clock::now() - t0).count());
-  }
-  return best;
+};
+
+void timeInTurns(std::vector<Method>& methods, int reps) {
+  for (int r = 0; r < reps; ++r)
+    for (Method& m : methods) {
+      const auto t0 = Clock::now();
+      m.run();
+      m.best = std::min(m.best, std::chrono::duration<double>(Clock::now() - t0).count());
+    }
+}
+
+// The primary rays of 8x8 pixel tiles, as vox-trace traces them: index[i] is the pixel of the i-th ray.
+void tracePackets(const vox::Accel& accel, const std::vector<vox::Ray>& rays, uint32_t size, uint32_t tile,
+                  vox::Hit* hits, vox::TraceStats* stats) {
+  const uint32_t tiles = (size + 7) / 8;
+  vox::Ray packet[vox::kMaxPacketRays];
+  vox::Hit out[vox::kMaxPacketRays];
+  uint64_t index[vox::kMaxPacketRays];
+  const uint32_t x0 = tile % tiles * 8, y0 = tile / tiles * 8;
+  uint32_t count = 0;
+  for (uint32_t y = y0; y < std::min(y0 + 8, size); ++y)
+    for (uint32_t x = x0; x < std::min(x0 + 8, size); ++x) {
+      index[count] = uint64_t(y) * size + x;
+      packet[count] = rays[index[count]];
+      ++count;
+    }
+  vox::tracePacket(accel, {packet, count}, {out, count}, stats);
+  if (hits)
+    for (uint32_t i = 0; i < count; ++i) hits[index[i]] = out[i];
 }
 
 std::array<uint32_t, 3> dimsForFactor(const vox::Box& b, size_t triangles, double factor) {
@@ -54,21 +82,23 @@ std::array<uint32_t, 3> dimsForFactor(const vox::Box& b, size_t triangles, doubl
 int main(int argc, char** argv) {
   unsigned threads = 1;
   uint32_t size = 1024;
+  int reps = 7;
   std::vector<double> factors;
   std::vector<std::string> scenes;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--threads" && i + 1 < argc) threads = unsigned(std::atoi(argv[++i]));
     else if (a == "--size" && i + 1 < argc) size = uint32_t(std::atoi(argv[++i]));
+    else if (a == "--reps" && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
     else if (a == "--factor" && i + 1 < argc) factors.push_back(std::atof(argv[++i]));
     else scenes.push_back(a);
   }
-  if (factors.empty()) factors = {1, 2, 4, 8};
+  if (factors.empty()) factors = {0.5, 1, 2, 3};
   if (scenes.empty())
     scenes = {std::string(VOX_SEED_DIR) + "/6837/scenes/bunny_40k.obj", std::string(VOX_SEED_DIR) + "/meshes/bun_zipper.ply",
               std::string(VOX_SEED_DIR) + "/meshes/derived/sheencloth_115k.obj"};
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
-  std::printf("threads: %u, image: %ux%u primary rays\n", threads, size, size);
+  std::printf("threads: %u, image: %ux%u primary rays, best of %d rounds taken in turns\n", threads, size, size, reps);
 
   for (const std::string& path : scenes) {
     const vox::Scene scene = vox::loadScene(path);
@@ -98,8 +128,9 @@ int main(int argc, char** argv) {
     rtcReleaseGeometry(geom);
     rtcCommitScene(es);
 
+    std::vector<Method> methods;
     std::vector<unsigned> embreeHit(rayCount);
-    const double e1 = bestSeconds([&] {
+    methods.push_back({"embree rtcIntersect1", [&] {
       tbb::parallel_for(tbb::blocked_range<uint64_t>(0, rayCount, 1024), [&](const tbb::blocked_range<uint64_t>& r) {
         RTCIntersectContext ctx;
         rtcInitIntersectContext(&ctx);
@@ -113,9 +144,9 @@ int main(int argc, char** argv) {
           embreeHit[i] = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? vox::kNoPrim : rh.hit.primID;
         }
       });
-    });
+    }});
     // Packets of 8: 4x2 pixel blocks, coherent context.
-    const double e8 = bestSeconds([&] {
+    methods.push_back({"embree rtcIntersect8 coherent", [&] {
       tbb::parallel_for(tbb::blocked_range<uint32_t>(0, size / 2), [&](const tbb::blocked_range<uint32_t>& rows) {
         RTCIntersectContext ctx;
         rtcInitIntersectContext(&ctx);
@@ -135,78 +166,69 @@ int main(int argc, char** argv) {
             rtcIntersect8(valid, es, &ctx, &rh);
           }
       });
-    });
+    }});
+
+    struct Variant {
+      std::unique_ptr<vox::Grid> grid;
+      std::unique_ptr<vox::Accel> accel;
+      double factor = 0, voxelizeSeconds = 0;
+      std::vector<uint32_t> single;
+      std::vector<vox::Hit> packet;
+    };
+    std::vector<Variant> variants(factors.size());
+    const uint32_t tiles = (size + 7) / 8;
+    for (size_t f = 0; f < factors.size(); ++f) {
+      Variant& v = variants[f];
+      v.factor = factors[f];
+      vox::VoxelizeOptions vo;
+      vo.dims = dimsForFactor(bounds, nt, v.factor);
+      const auto v0 = Clock::now();
+      v.grid = std::make_unique<vox::Grid>(vox::voxelizeScene(scene, vo));
+      v.voxelizeSeconds = std::chrono::duration<double>(Clock::now() - v0).count();
+      v.accel = std::make_unique<vox::Accel>(vox::buildAccel(scene, *v.grid, vox::AccelKind::Grid));
+      v.single.resize(rayCount);
+      v.packet.resize(rayCount);
+      methods.push_back({"grid traceRay", [&v, &rays, rayCount] {
+        tbb::parallel_for(tbb::blocked_range<uint64_t>(0, rayCount, 1024), [&](const tbb::blocked_range<uint64_t>& r) {
+          for (uint64_t i = r.begin(); i < r.end(); ++i) v.single[i] = vox::traceRay(*v.accel, rays[i]).prim;
+        });
+      }});
+      methods.push_back({"grid tracePacket", [&v, &rays, size, tiles] {
+        tbb::parallel_for(tbb::blocked_range<uint32_t>(0, tiles * tiles, 16), [&](const tbb::blocked_range<uint32_t>& r) {
+          for (uint32_t tile = r.begin(); tile < r.end(); ++tile) tracePackets(*v.accel, rays, size, tile, v.packet.data(), nullptr);
+        });
+      }});
+    }
+    timeInTurns(methods, reps);
     rtcReleaseScene(es);
     rtcReleaseDevice(device);
 
+    const double e1 = methods[0].best, e8 = methods[1].best;
     const char* name = std::strrchr(path.c_str(), '/') ? std::strrchr(path.c_str(), '/') + 1 : path.c_str();
     std::printf("\n%s: %zu triangles\n", name, nt);
     std::printf("  embree rtcIntersect1:            %8.2f Mrays/s\n", rayCount / e1 / 1e6);
     std::printf("  embree rtcIntersect8 coherent:   %8.2f Mrays/s\n", rayCount / e8 / 1e6);
-    for (double f : factors) {
-      vox::VoxelizeOptions vo;
-      vo.dims = dimsForFactor(bounds, nt, f);
-      const auto v0 = Clock::now();
-      const vox::Grid grid = vox::voxelizeScene(scene, vo);
-      const double vs = std::chrono::duration<double>(Clock::now() - v0).count();
-      const vox::Accel accel = vox::buildAccel(scene, grid, vox::AccelKind::Grid);
-      std::vector<uint32_t> ours(rayCount);
-      const double g = bestSeconds([&] {
-        tbb::parallel_for(tbb::blocked_range<uint64_t>(0, rayCount, 1024), [&](const tbb::blocked_range<uint64_t>& r) {
-          for (uint64_t i = r.begin(); i < r.end(); ++i) ours[i] = vox::traceRay(accel, rays[i]).prim;
-        });
-      });
-      // Packets: 8x8 pixel tiles through vox::tracePacket.
-      std::vector<vox::Hit> packetHits(rayCount);
-      const uint32_t tiles = (size + 7) / 8;
-      const double gp = bestSeconds([&] {
-        tbb::parallel_for(tbb::blocked_range<uint32_t>(0, tiles * tiles, 16), [&](const tbb::blocked_range<uint32_t>& r) {
-          vox::Ray packet[vox::kMaxPacketRays];
-          vox::Hit out[vox::kMaxPacketRays];
-          uint64_t index[vox::kMaxPacketRays];
-          for (uint32_t tile = r.begin(); tile < r.end(); ++tile) {
-            const uint32_t x0 = tile % tiles * 8, y0 = tile / tiles * 8;
-            uint32_t count = 0;
-            for (uint32_t y = y0; y < std::min(y0 + 8, size); ++y)
-              for (uint32_t x = x0; x < std::min(x0 + 8, size); ++x) {
-                index[count] = uint64_t(y) * size + x;
-                packet[count] = rays[index[count]];
-                ++count;
-              }
-            vox::tracePacket(accel, {packet, count}, {out, count});
-            for (uint32_t i = 0; i < count; ++i) packetHits[index[i]] = out[i];
-          }
-        });
-      });
-      uint64_t packetSame = 0;
-      for (uint64_t i = 0; i < rayCount; ++i) packetSame += packetHits[i].prim == ours[i];
-      vox::TraceStats pst;
-      {
-        vox::Ray packet[vox::kMaxPacketRays];
-        vox::Hit out[vox::kMaxPacketRays];
-        for (uint32_t tile = 0; tile < tiles * tiles; tile += 7) {
-          const uint32_t x0 = tile % tiles * 8, y0 = tile / tiles * 8;
-          uint32_t count = 0;
-          for (uint32_t y = y0; y < std::min(y0 + 8, size); ++y)
-            for (uint32_t x = x0; x < std::min(x0 + 8, size); ++x) packet[count++] = rays[uint64_t(y) * size + x];
-          vox::tracePacket(accel, {packet, count}, {out, count}, &pst);
-        }
-      }
-      vox::TraceStats st;
-      for (uint64_t i = 0; i < rayCount; i += 97) vox::traceRay(accel, rays[i], &st);
-      uint64_t same = 0, hits = 0;
+    for (size_t f = 0; f < variants.size(); ++f) {
+      const Variant& v = variants[f];
+      const double g = methods[2 + 2 * f].best, gp = methods[3 + 2 * f].best;
+      vox::TraceStats st, pst;
+      for (uint64_t i = 0; i < rayCount; i += 97) vox::traceRay(*v.accel, rays[i], &st);
+      for (uint32_t tile = 0; tile < tiles * tiles; tile += 7) tracePackets(*v.accel, rays, size, tile, nullptr, &pst);
+      uint64_t same = 0, packetSame = 0, hits = 0;
       for (uint64_t i = 0; i < rayCount; ++i) {
-        same += ours[i] == embreeHit[i];
-        hits += ours[i] != vox::kNoPrim;
+        same += v.single[i] == embreeHit[i];
+        packetSame += v.packet[i].prim == v.single[i];
+        hits += v.single[i] != vox::kNoPrim;
       }
-      std::printf("  grid %4ux%4ux%4u (%.0f cells/tri, voxelize %.2f s): %8.2f Mrays/s  ratio vs rtcIntersect1 %.3f, "
-                  "vs rtcIntersect8 %.3f  cells/ray %.1f tests/ray %.1f  hits %.1f%%  same prim as embree %.3f%%\n",
-                  grid.dims[0], grid.dims[1], grid.dims[2], f, vs, rayCount / g / 1e6, e1 / g, e8 / g,
-                  double(st.cells) / st.rays, double(st.tests) / st.rays, 100.0 * hits / rayCount,
+      std::printf("  grid %4ux%4ux%4u (%.1f cells/tri, voxelize %.2f s), %.1f%% of rays hit\n", v.grid->dims[0],
+                  v.grid->dims[1], v.grid->dims[2], v.factor, v.voxelizeSeconds, 100.0 * hits / rayCount);
+      std::printf("    traceRay:    %8.2f Mrays/s  ratio vs rtcIntersect1 %.3f, vs rtcIntersect8 %.3f  cells/ray %.2f "
+                  "tests/ray %.2f  same prim as embree %.3f%%\n",
+                  rayCount / g / 1e6, e1 / g, e8 / g, double(st.cells) / st.rays, double(st.tests) / st.rays,
                   100.0 * same / rayCount);
-      std::printf("  grid packets 8x8:%41s %8.2f Mrays/s  ratio vs rtcIntersect1 %.3f, vs rtcIntersect8 %.3f  "
-                  "cells/ray %.2f tests/ray %.1f  same hit as single rays %.3f%%\n",
-                  "", rayCount / gp / 1e6, e1 / gp, e8 / gp, double(pst.cells) / pst.rays, double(pst.tests) / pst.rays,
+      std::printf("    tracePacket: %8.2f Mrays/s  ratio vs rtcIntersect1 %.3f, vs rtcIntersect8 %.3f  cells/ray %.2f "
+                  "tests/ray %.2f  same prim as traceRay %.3f%%\n",
+                  rayCount / gp / 1e6, e1 / gp, e8 / gp, double(pst.cells) / pst.rays, double(pst.tests) / pst.rays,
                   100.0 * packetSame / rayCount);
       std::fflush(stdout);
     }

@@ -34,26 +34,26 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr uint64_t kMaxCellsPerLane = 4;
 
 // The rays of the packet that are still walking, as a structure of arrays, so that one triangle is tested against
-// all of them in vector registers.
+// all of them in vector registers and the per-slice bookkeeping runs over contiguous data.
 struct Lanes {
-  alignas(64) double ox[kMaxPacketRays], oy[kMaxPacketRays], oz[kMaxPacketRays];
-  alignas(64) double dx[kMaxPacketRays], dy[kMaxPacketRays], dz[kMaxPacketRays];
-  alignas(64) double tMin[kMaxPacketRays], tMax[kMaxPacketRays];
-  alignas(64) double t[kMaxPacketRays];  // result of the last test: the hit's t, NaN for a miss
-  uint32_t ray[kMaxPacketRays];          // index of the lane's ray in the packet
+  static constexpr uint32_t N = kMaxPacketRays;
+  // The ray, for the triangle kernel.
+  alignas(64) double ox[N], oy[N], oz[N], dx[N], dy[N], dz[N], tMin[N], tMax[N];
+  alignas(64) double t[N];  // result of the last test: the hit's t (valid where the hit bit is set)
+  // The walk along the slice axis k: the ray crosses x_k = b at (b - ok) * invK; tolK is the walker's tolerance
+  // there (RayAxes::tol[k]); the ray is done with slices entered after stopAt (the end of its walk, or its best
+  // hit plus the hit slack).
+  alignas(64) double ok[N], invK[N], tolK[N], stopAt[N], tEnd[N], hitSlack[N];
+  // Position a + c s on the two other axes at slab coordinate c (relative to the packet's reference).
+  alignas(64) double a[2][N], s[2][N];
+  uint32_t ray[N];  // index of the lane's ray in the packet
   uint32_t count = 0;
 
-  void add(uint32_t r, const Ray& ray) {
-    const uint32_t j = count++;
-    ox[j] = ray.origin.x, oy[j] = ray.origin.y, oz[j] = ray.origin.z;
-    dx[j] = ray.direction.x, dy[j] = ray.direction.y, dz[j] = ray.direction.z;
-    tMin[j] = ray.tMin, tMax[j] = ray.tMax;
-    this->ray[j] = r;
-  }
   void remove(uint32_t j) {
     const uint32_t e = --count;
-    ox[j] = ox[e], oy[j] = oy[e], oz[j] = oz[e], dx[j] = dx[e], dy[j] = dy[e], dz[j] = dz[e];
-    tMin[j] = tMin[e], tMax[j] = tMax[e], ray[j] = ray[e];
+    for (double* v : {ox, oy, oz, dx, dy, dz, tMin, tMax, ok, invK, tolK, stopAt, tEnd, hitSlack, a[0], a[1], s[0], s[1]})
+      v[j] = v[e];
+    ray[j] = ray[e];
   }
 };
 
@@ -100,7 +100,7 @@ struct PacketMailbox {
 };
 
 // The axis along which the packet is sliced: the first ray's largest direction component, provided every ray is
-// finite and travels the same way along it with a slope of at most 2 in the other axes. -1 when there is none (the
+// finite and travels the same way along it (1 / d_k a normal number) with a slope of at most 2 in the other axes. -1 when there is none (the
 // rays are then traced one by one).
 int sliceAxis(const Accel& accel, std::span<const Ray> rays) {
   const CellBoundaries& cb = accel.boundaries;
@@ -114,7 +114,7 @@ int sliceAxis(const Accel& accel, std::span<const Ray> rays) {
   for (const Ray& ray : rays) {
     if (!isFinite(ray.origin) || !isFinite(ray.direction) || std::isnan(ray.tMin) || std::isnan(ray.tMax)) return -1;
     const double dk = ray.direction[k];
-    if (dk == 0 || (dk > 0) != forward) return -1;
+    if (!std::isnormal(1.0 / dk) || (dk > 0) != forward) return -1;
     const double other = std::max(std::fabs(ray.direction[(k + 1) % 3]), std::fabs(ray.direction[(k + 2) % 3]));
     if (!(std::fabs(dk) >= 0.5 * other)) return -1;
   }
@@ -167,19 +167,6 @@ bool outsidePacket(const TriangleData& tri, int k, const int other[2], double c0
   return false;
 }
 
-// What a lane needs of its ray besides the lane arrays: the slab position (a, s) on the other two axes, and the
-// walker's tolerances on the slice axis k.
-struct RayState {
-  double a[2], s[2];
-  double invK;      // 1 / d_k
-  bool divideK;     // 1 / d_k is not a normal number: divide by d_k instead (as RayAxes::crossing)
-  double tolK;      // RayAxes::tol[k]
-  double hitSlack;  // at least RayAxes::hitSlack: divided by |d_k| instead of the largest |d|
-  double tEnd;      // tMax widened by the hit slack, as the walker's last parameter
-
-  double crossingK(double b, double o, double d) const { return divideK ? (b - o) / d : (b - o) * invK; }
-};
-
 void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<Hit> hits, TraceStats* stats) {
   const int k = sliceAxis(accel, rays);
   if (k < 0) {
@@ -196,7 +183,6 @@ void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<H
 
   TraceStats st;
   st.rays = n;
-  RayState state[kMaxPacketRays];
   Hit best[kMaxPacketRays];
   Lanes lanes{};
   AxisBounds bounds[2];
@@ -211,33 +197,56 @@ void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<H
       ++st.tests;
       if (intersectPrimitive(accel, id, ray, t) && closer(t, id, best[r])) best[r] = {t, id};
     }
-    RayState& rs = state[r];
+    const uint32_t l = lanes.count++;
+    lanes.ray[l] = r;
+    lanes.ox[l] = ray.origin.x, lanes.oy[l] = ray.origin.y, lanes.oz[l] = ray.origin.z;
+    lanes.dx[l] = ray.direction.x, lanes.dy[l] = ray.direction.y, lanes.dz[l] = ray.direction.z;
+    lanes.tMin[l] = ray.tMin, lanes.tMax[l] = ray.tMax;
     const double dk = ray.direction[k], ok = ray.origin[k];
-    rs.invK = 1.0 / dk;
-    rs.divideK = !std::isnormal(rs.invK);
-    const double absInv = rs.divideK ? 1.0 / std::fabs(dk) : std::fabs(rs.invK);
-    const double tolPosK = kCellSlack * cb.cellSize[k] + 64 * kEps * (std::fabs(ok) + cb.magnitude[k]);
-    rs.tolK = rs.divideK ? tolPosK / std::fabs(dk) : tolPosK * absInv;
+    const double invK = 1.0 / dk, absInv = std::fabs(invK);
+    lanes.ok[l] = ok;
+    lanes.invK[l] = invK;
+    lanes.tolK[l] = (kCellSlack * cb.cellSize[k] + 64 * kEps * (std::fabs(ok) + cb.magnitude[k])) * absInv;
     double scale = 0;
     for (int a = 0; a < 3; ++a) scale = std::max(scale, std::fabs(ray.origin[a]) + cb.magnitude[a]);
-    rs.hitSlack = (kCellSlack * cb.minCell + 64 * kEps * scale) * absInv;
-    rs.tEnd = ray.tMax + (rs.hitSlack + 1e-9 * std::fabs(ray.tMax));
-    const double pStart = ok + ray.tMin * dk, pEnd = ok + rs.tEnd * dk;
+    // At least RayAxes::hitSlack: divided by |d_k| instead of the largest |d|.
+    const double hitSlack = (kCellSlack * cb.minCell + 64 * kEps * scale) * absInv;
+    const double tEnd = ray.tMax + (hitSlack + 1e-9 * std::fabs(ray.tMax));  // the walker's last parameter
+    lanes.hitSlack[l] = hitSlack;
+    lanes.tEnd[l] = tEnd;
+    lanes.stopAt[l] = best[r].valid() ? std::min(tEnd, best[r].t + (hitSlack + 1e-9 * std::fabs(best[r].t))) : tEnd;
+    const double pStart = ok + ray.tMin * dk, pEnd = ok + tEnd * dk;
+    // A ray that passes beside the grid box needs no lane (its a + c s stays off the grid's range on some axis over
+    // the grid's slab range; the margin covers the rounding, as in AxisBounds::cells).
+    const double shift = c0 - ok, cGridLo = bk[0] - c0, cGridHi = bk[nk] - c0;
+    bool beside = false;
+    for (int q = 0; q < 2; ++q) {
+      const int u = other[q];
+      const double slope = ray.direction[u] * invK, at = ray.origin[u] + shift * slope;
+      const double p0 = at + cGridLo * slope, p1 = at + cGridHi * slope;
+      const double margin = kCellSlack * cb.cellSize[u] +
+                            64 * kEps * (std::fabs(at) + std::fabs(ray.origin[u]) + std::fabs(shift * slope) +
+                                         std::max(std::fabs(cGridLo), std::fabs(cGridHi)) * std::fabs(slope) + cb.magnitude[u]);
+      beside |= std::max(p0, p1) < cb.b[u].front() - margin || std::min(p0, p1) > cb.b[u].back() + margin;
+    }
+    if (beside) {
+      --lanes.count;
+      continue;
+    }
     pLo = std::min({pLo, pStart, pEnd});
     pHi = std::max({pHi, pStart, pEnd});
     for (double p : {pStart, pEnd})
       if (std::isfinite(p)) originMax[k] = std::max(originMax[k], std::fabs(p));
-    const double shift = c0 - ok;
     for (int q = 0; q < 2; ++q) {
       const int u = other[q];
-      rs.s[q] = rs.divideK ? ray.direction[u] / dk : ray.direction[u] * rs.invK;
-      rs.a[q] = ray.origin[u] + shift * rs.s[q];
-      bounds[q].magnitude = std::max(bounds[q].magnitude, std::fabs(rs.a[q]) + std::fabs(ray.origin[u]) +
-                                                              std::fabs(shift) * std::fabs(rs.s[q]));
-      bounds[q].sMax = std::max(bounds[q].sMax, std::fabs(rs.s[q]));
+      const double slope = ray.direction[u] * invK, at = ray.origin[u] + shift * slope;
+      lanes.s[q][l] = slope;
+      lanes.a[q][l] = at;
+      bounds[q].magnitude = std::max(bounds[q].magnitude, std::fabs(at) + std::fabs(ray.origin[u]) +
+                                                              std::fabs(shift) * std::fabs(slope));
+      bounds[q].sMax = std::max(bounds[q].sMax, std::fabs(slope));
       originMax[u] = std::max(originMax[u], std::fabs(ray.origin[u]));
     }
-    lanes.add(r, ray);
   }
   for (int q = 0; q < 2; ++q) {
     const int u = other[q];
@@ -256,13 +265,11 @@ void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<H
     if (boundsStale) {
       for (int q = 0; q < 2; ++q) {
         AxisBounds& ab = bounds[q];
-        const RayState& s0 = state[lanes.ray[0]];
-        ab.aLo = ab.aHi = s0.a[q];
-        ab.sLo = ab.sHi = s0.s[q];
+        ab.aLo = ab.aHi = lanes.a[q][0];
+        ab.sLo = ab.sHi = lanes.s[q][0];
         for (uint32_t j = 1; j < lanes.count; ++j) {
-          const RayState& rs = state[lanes.ray[j]];
-          ab.aLo = std::min(ab.aLo, rs.a[q]), ab.aHi = std::max(ab.aHi, rs.a[q]);
-          ab.sLo = std::min(ab.sLo, rs.s[q]), ab.sHi = std::max(ab.sHi, rs.s[q]);
+          ab.aLo = std::min(ab.aLo, lanes.a[q][j]), ab.aHi = std::max(ab.aHi, lanes.a[q][j]);
+          ab.sLo = std::min(ab.sLo, lanes.s[q][j]), ab.sHi = std::max(ab.sHi, lanes.s[q][j]);
         }
       }
       boundsStale = false;
@@ -313,24 +320,29 @@ void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<H
           for (; hitBits != 0; hitBits &= hitBits - 1) {
             const uint32_t l = uint32_t(__builtin_ctzll(hitBits));
             Hit& h = best[lanes.ray[l]];
-            if (closer(lanes.t[l], id, h)) h = {lanes.t[l], id};
+            const double t = lanes.t[l];
+            if (closer(t, id, h)) {
+              h = {t, id};
+              lanes.stopAt[l] = std::min(lanes.tEnd[l], t + (lanes.hitSlack[l] + 1e-9 * std::fabs(t)));
+            }
           }
         }
       }
     }
     if (slice == last) break;
-    // Retire the rays that cannot meet anything nearer in the slices to come, or whose walk ends before them.
+    // Retire the rays that cannot meet anything nearer in the slices to come (the stop rule of traceRay: the best
+    // hit plus its slack lies before the next slice's boundary minus the exit slack), or whose walk ends before them.
     const double boundary = forward ? bk[slice + 1] : bk[slice];
-    for (uint32_t l = lanes.count; l-- > 0;) {
-      const uint32_t r = lanes.ray[l];
-      const RayState& rs = state[r];
-      const double tCross = rs.crossingK(boundary, rays[r].origin[k], rays[r].direction[k]);
-      const double tNextMin = tCross - (rs.tolK + kWalkRel * std::fabs(tCross));
-      const Hit& h = best[r];
-      if (tNextMin > rs.tEnd || (h.valid() && h.t + (rs.hitSlack + 1e-9 * std::fabs(h.t)) < tNextMin)) {
-        lanes.remove(l);
-        boundsStale = true;
-      }
+    uint64_t retire = 0;
+    for (uint32_t l = 0; l < lanes.count; ++l) {
+      const double tCross = (boundary - lanes.ok[l]) * lanes.invK[l];
+      const double tNextMin = tCross - (lanes.tolK[l] + kWalkRel * std::fabs(tCross));
+      retire |= uint64_t(lanes.stopAt[l] < tNextMin) << l;
+    }
+    if (retire != 0) {
+      // Highest first: remove() moves the last lane into the freed one, and lanes above were already handled.
+      for (; retire != 0; retire &= ~(uint64_t(1) << (63 - __builtin_clzll(retire)))) lanes.remove(63 - __builtin_clzll(retire));
+      boundsStale = true;
     }
   }
   for (uint32_t r = 0; r < n; ++r) hits[r] = best[r];

@@ -49,6 +49,13 @@ struct Lanes {
   uint32_t ray[N];  // index of the lane's ray in the packet
   uint32_t count = 0;
 
+  // The kernel runs over groups of four lanes: give the lanes past `count` in the last group defined values (a
+  // removed lane keeps its old, defined values).
+  void padTail() {
+    for (uint32_t j = count; j < N && j % 4 != 0; ++j)
+      for (double* v : {ox, oy, oz, dx, dy, dz, tMin, tMax}) v[j] = 0;
+  }
+
   void remove(uint32_t j) {
     const uint32_t e = --count;
     for (double* v : {ox, oy, oz, dx, dy, dz, tMin, tMax, ok, invK, tolK, stopAt, tEnd, hitSlack, a[0], a[1], s[0], s[1]})
@@ -59,7 +66,7 @@ struct Lanes {
 
 // One triangle against every lane, four at a time. Compiled twice, for AVX2 and for the baseline, and picked at
 // load time: the arithmetic is IEEE double either way (no contraction), so both give the scalar test's t. Lanes past
-// `count` hold zeros or retired rays; their results are never read. Returns the lanes hit, as bits.
+// `count` hold zeros or retired rays (Lanes::padTail); their results are never read. Returns the lanes hit, as bits.
 __attribute__((target_clones("avx2", "default"))) uint64_t triangleLanes(const TriangleData& tri, Lanes& lanes) {
   using kernel::Double4;
   const double v0[3] = {tri.v0.x, tri.v0.y, tri.v0.z}, e1[3] = {tri.e1.x, tri.e1.y, tri.e1.z},
@@ -167,6 +174,25 @@ bool outsidePacket(const TriangleData& tri, int k, const int other[2], double c0
   return false;
 }
 
+// Whether every block of the two-level table in the layer of blocks holding `slice` (slice axis k) and in the cell
+// ranges ru x rv of the other axes is empty; false for a wide rectangle, which is not worth the look.
+bool allBlocksEmpty(const Accel& accel, int k, const int other[2], int64_t slice, const std::array<int64_t, 3>& ru,
+                    const std::array<int64_t, 3>& rv) {
+  if (ru[0] > ru[1] || rv[0] > rv[1]) return true;
+  const uint32_t s = accel.blockShift;
+  const int64_t u0 = ru[0] >> s, u1 = ru[1] >> s, v0 = rv[0] >> s, v1 = rv[1] >> s;
+  if ((u1 - u0 + 1) * (v1 - v0 + 1) > 16) return false;
+  uint64_t b[3];
+  b[k] = uint64_t(slice) >> s;
+  for (int64_t v = v0; v <= v1; ++v)
+    for (int64_t u = u0; u <= u1; ++u) {
+      b[other[0]] = uint64_t(u), b[other[1]] = uint64_t(v);
+      if (accel.blockSlot[b[0] + accel.blockDims[0] * (b[1] + uint64_t(accel.blockDims[1]) * b[2])] != kEmptyCell)
+        return false;
+    }
+  return true;
+}
+
 void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<Hit> hits, TraceStats* stats) {
   const int k = sliceAxis(accel, rays);
   if (k < 0) {
@@ -184,7 +210,7 @@ void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<H
   TraceStats st;
   st.rays = n;
   Hit best[kMaxPacketRays];
-  Lanes lanes{};
+  Lanes lanes;  // not zeroed: 10 KB per packet would cost more than a packet's slices; see padTail()
   AxisBounds bounds[2];
   double originMax[3] = {0, 0, 0};
   // The span of slab coordinates the rays cover within [tMin, tEnd].
@@ -256,11 +282,20 @@ void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<H
   const double padK = kCellSlack * cb.cellSize[k] + 64 * kEps * (originMax[k] + cb.magnitude[k]);
   const auto range = cellRangeOnAxis(nk, cb.cellsPerUnit[k], [bk](int64_t i) { return bk[i]; }, pLo - padK, pHi + padK);
   if (range[0] > range[1]) lanes.count = 0;
+  if (lanes.count == 0) {
+    for (uint32_t r = 0; r < n; ++r) hits[r] = best[r];
+    if (stats) *stats += st;
+    return;
+  }
+  lanes.padTail();
   const int64_t first = forward ? range[0] : range[1], last = forward ? range[1] : range[0];
 
   PacketMailbox mailbox;
   bool boundsStale = true;
   const int64_t step = forward ? 1 : -1;
+  const uint32_t shift = accel.blockShift;
+  const int64_t blockMask = (int64_t(1) << shift) - 1;
+  int64_t checkedUpTo = -2;  // the slices of a layer of blocks found not empty run up to this one
   for (int64_t slice = first; lanes.count > 0; slice += step) {
     if (boundsStale) {
       for (int q = 0; q < 2; ++q) {
@@ -273,6 +308,20 @@ void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<H
         }
       }
       boundsStale = false;
+    }
+    // Empty-space skipping: the slices to the end of the current layer of blocks (Accel::blockSlot) are passed over
+    // in one step when every block the packet can touch in them is empty.
+    if (shift != 0 && slice != checkedUpTo) {
+      const int64_t layerEnd = forward ? std::min(slice | blockMask, last) : std::max(slice & ~blockMask, last);
+      const double cA = bk[forward ? slice : slice + 1] - c0, cB = bk[forward ? layerEnd + 1 : layerEnd] - c0;
+      const auto ru = bounds[0].cells(cb, other[0], cA, cB);
+      const auto rv = bounds[1].cells(cb, other[1], cA, cB);
+      if (allBlocksEmpty(accel, k, other, slice, ru, rv)) {
+        if (layerEnd == last) break;
+        slice = layerEnd;
+        continue;
+      }
+      checkedUpTo = layerEnd;
     }
     const double cA = bk[slice] - c0, cB = bk[slice + 1] - c0;
     const auto ru = bounds[0].cells(cb, other[0], cA, cB);

@@ -3,7 +3,8 @@
 // Default scenes: the 40k seed bunny, the 69k Stanford bunny (PLY), the 115k SheenCloth. For each scene it voxelizes
 // (exact) at each cells-per-triangle factor and traces size x size primary rays from defaultCamera(bounds) with
 // rtcIntersect1, rtcIntersect8 (coherent context, 4x2 pixel packets), vox::traceRay (one ray at a time) and
-// vox::tracePacket (8x8 pixel packets, as vox-trace renders). The methods take turns, `reps` rounds, and each keeps
+// vox::tracePacket (8x8 pixel packets, as vox-trace renders). rtcIntersect1 and traceRay take the rays in the same
+// order as the packets, tile after tile. The methods take turns, `reps` rounds, and each keeps
 // its best time, so that a burst of load on a shared machine hits them alike. Prints rays per second, the ratios
 // ours / Embree, cells and tests per ray, and how many pixels hit the same triangle as Embree and as traceRay.
 #include <embree3/rtcore.h>
@@ -48,24 +49,31 @@ void timeInTurns(std::vector<Method>& methods, int reps) {
     }
 }
 
-// The primary rays of 8x8 pixel tiles, as vox-trace traces them: index[i] is the pixel of the i-th ray.
-void tracePackets(const vox::Accel& accel, const std::vector<vox::Ray>& rays, uint32_t size, uint32_t tile,
-                  vox::Hit* hits, vox::TraceStats* stats) {
-  const uint32_t tiles = (size + 7) / 8;
-  vox::Ray packet[vox::kMaxPacketRays];
-  vox::Hit out[vox::kMaxPacketRays];
-  uint64_t index[vox::kMaxPacketRays];
-  const uint32_t x0 = tile % tiles * 8, y0 = tile / tiles * 8;
-  uint32_t count = 0;
-  for (uint32_t y = y0; y < std::min(y0 + 8, size); ++y)
-    for (uint32_t x = x0; x < std::min(x0 + 8, size); ++x) {
-      index[count] = uint64_t(y) * size + x;
-      packet[count] = rays[index[count]];
-      ++count;
+// The rays in the order vox-trace makes them: 8x8 pixel tiles, tile after tile (pixel[i] is the pixel of ray i).
+struct TiledRays {
+  std::vector<vox::Ray> rays;
+  std::vector<uint64_t> pixel;
+  std::vector<uint32_t> tileStart;  // first ray of each tile, and the end
+};
+TiledRays tileRays(const std::vector<vox::Ray>& rays, uint32_t size) {
+  TiledRays t;
+  for (uint32_t y0 = 0; y0 < size; y0 += 8)
+    for (uint32_t x0 = 0; x0 < size; x0 += 8) {
+      t.tileStart.push_back(uint32_t(t.rays.size()));
+      for (uint32_t y = y0; y < std::min(y0 + 8, size); ++y)
+        for (uint32_t x = x0; x < std::min(x0 + 8, size); ++x) {
+          t.pixel.push_back(uint64_t(y) * size + x);
+          t.rays.push_back(rays[t.pixel.back()]);
+        }
     }
-  vox::tracePacket(accel, {packet, count}, {out, count}, stats);
-  if (hits)
-    for (uint32_t i = 0; i < count; ++i) hits[index[i]] = out[i];
+  t.tileStart.push_back(uint32_t(t.rays.size()));
+  return t;
+}
+
+// One tile through vox::tracePacket; hits in tile order.
+void tracePackets(const vox::Accel& accel, const TiledRays& tiled, size_t tile, vox::Hit* hits, vox::TraceStats* stats) {
+  const uint32_t begin = tiled.tileStart[tile], count = tiled.tileStart[tile + 1] - begin;
+  vox::tracePacket(accel, {tiled.rays.data() + begin, count}, {hits + begin, count}, stats);
 }
 
 std::array<uint32_t, 3> dimsForFactor(const vox::Box& b, size_t triangles, double factor) {
@@ -128,6 +136,8 @@ int main(int argc, char** argv) {
     rtcReleaseGeometry(geom);
     rtcCommitScene(es);
 
+    const TiledRays tiled = tileRays(rays, size);
+    const size_t tileCount = tiled.tileStart.size() - 1;
     std::vector<Method> methods;
     std::vector<unsigned> embreeHit(rayCount);
     methods.push_back({"embree rtcIntersect1", [&] {
@@ -135,13 +145,14 @@ int main(int argc, char** argv) {
         RTCIntersectContext ctx;
         rtcInitIntersectContext(&ctx);
         for (uint64_t i = r.begin(); i < r.end(); ++i) {
+          const vox::Ray& ray = tiled.rays[i];
           RTCRayHit rh{};
-          rh.ray.org_x = float(rays[i].origin.x), rh.ray.org_y = float(rays[i].origin.y), rh.ray.org_z = float(rays[i].origin.z);
-          rh.ray.dir_x = float(rays[i].direction.x), rh.ray.dir_y = float(rays[i].direction.y), rh.ray.dir_z = float(rays[i].direction.z);
+          rh.ray.org_x = float(ray.origin.x), rh.ray.org_y = float(ray.origin.y), rh.ray.org_z = float(ray.origin.z);
+          rh.ray.dir_x = float(ray.direction.x), rh.ray.dir_y = float(ray.direction.y), rh.ray.dir_z = float(ray.direction.z);
           rh.ray.tnear = 0, rh.ray.tfar = INFINITY, rh.ray.mask = unsigned(-1);
           rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
           rtcIntersect1(es, &ctx, &rh);
-          embreeHit[i] = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? vox::kNoPrim : rh.hit.primID;
+          embreeHit[tiled.pixel[i]] = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? vox::kNoPrim : rh.hit.primID;
         }
       });
     }});
@@ -176,7 +187,6 @@ int main(int argc, char** argv) {
       std::vector<vox::Hit> packet;
     };
     std::vector<Variant> variants(factors.size());
-    const uint32_t tiles = (size + 7) / 8;
     for (size_t f = 0; f < factors.size(); ++f) {
       Variant& v = variants[f];
       v.factor = factors[f];
@@ -188,14 +198,14 @@ int main(int argc, char** argv) {
       v.accel = std::make_unique<vox::Accel>(vox::buildAccel(scene, *v.grid, vox::AccelKind::Grid));
       v.single.resize(rayCount);
       v.packet.resize(rayCount);
-      methods.push_back({"grid traceRay", [&v, &rays, rayCount] {
+      methods.push_back({"grid traceRay", [&v, &tiled, rayCount] {
         tbb::parallel_for(tbb::blocked_range<uint64_t>(0, rayCount, 1024), [&](const tbb::blocked_range<uint64_t>& r) {
-          for (uint64_t i = r.begin(); i < r.end(); ++i) v.single[i] = vox::traceRay(*v.accel, rays[i]).prim;
+          for (uint64_t i = r.begin(); i < r.end(); ++i) v.single[tiled.pixel[i]] = vox::traceRay(*v.accel, tiled.rays[i]).prim;
         });
       }});
-      methods.push_back({"grid tracePacket", [&v, &rays, size, tiles] {
-        tbb::parallel_for(tbb::blocked_range<uint32_t>(0, tiles * tiles, 16), [&](const tbb::blocked_range<uint32_t>& r) {
-          for (uint32_t tile = r.begin(); tile < r.end(); ++tile) tracePackets(*v.accel, rays, size, tile, v.packet.data(), nullptr);
+      methods.push_back({"grid tracePacket", [&v, &tiled, tileCount] {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, tileCount, 16), [&](const tbb::blocked_range<size_t>& r) {
+          for (size_t tile = r.begin(); tile < r.end(); ++tile) tracePackets(*v.accel, tiled, tile, v.packet.data(), nullptr);
         });
       }});
     }
@@ -213,11 +223,12 @@ int main(int argc, char** argv) {
       const double g = methods[2 + 2 * f].best, gp = methods[3 + 2 * f].best;
       vox::TraceStats st, pst;
       for (uint64_t i = 0; i < rayCount; i += 97) vox::traceRay(*v.accel, rays[i], &st);
-      for (uint32_t tile = 0; tile < tiles * tiles; tile += 7) tracePackets(*v.accel, rays, size, tile, nullptr, &pst);
+      std::vector<vox::Hit> scratch(rayCount);
+      for (size_t tile = 0; tile < tileCount; tile += 7) tracePackets(*v.accel, tiled, tile, scratch.data(), &pst);
       uint64_t same = 0, packetSame = 0, hits = 0;
       for (uint64_t i = 0; i < rayCount; ++i) {
         same += v.single[i] == embreeHit[i];
-        packetSame += v.packet[i].prim == v.single[i];
+        packetSame += v.packet[i].prim == v.single[tiled.pixel[i]];
         hits += v.single[i] != vox::kNoPrim;
       }
       std::printf("  grid %4ux%4ux%4u (%.1f cells/tri, voxelize %.2f s), %.1f%% of rays hit\n", v.grid->dims[0],

@@ -1,9 +1,10 @@
 // tracePacket must return, for every ray, exactly what traceRay returns (and so what the brute force returns on
-// exact, sat and bbox grids): same primitive, same t bit for bit. Coherent packets take the slice walk; the tests
+// exact, sat and bbox grids): same primitive, same t bit for bit; occludedPacket what occluded returns. Coherent packets take the slice walk; the tests
 // check that they do (fewer cells than the rays' own walks), so a silent fallback to single rays cannot pass them.
 #include <gtest/gtest.h>
 
 #include <bit>
+#include <memory>
 #include <random>
 #include <sstream>
 
@@ -40,7 +41,18 @@ PacketCheck expectPacketsMatch(const Accel& grid, const Accel& none, const std::
     const size_t count = std::min<size_t>(packetSize, rays.size() - begin);
     tracePacket(grid, std::span(rays).subspan(begin, count), std::span(hits).subspan(begin, count), &packetStats);
   }
+  std::unique_ptr<bool[]> blocked(new bool[rays.size()]);
+  for (size_t begin = 0; begin < rays.size(); begin += packetSize) {
+    const size_t count = std::min<size_t>(packetSize, rays.size() - begin);
+    occludedPacket(grid, std::span(rays).subspan(begin, count), std::span(blocked.get() + begin, count));
+  }
   int failures = 0;
+  for (size_t r = 0; r < rays.size() && failures < 5; ++r) {
+    const bool single = occluded(grid, rays[r]), brute = occluded(none, rays[r]);
+    EXPECT_EQ(blocked[r], single) << what << " ray " << r << " " << describe(rays[r]) << ": occlusion";
+    EXPECT_EQ(single, brute) << what << " ray " << r << " " << describe(rays[r]) << ": occlusion, brute force";
+    failures += blocked[r] != single || single != brute;
+  }
   for (size_t r = 0; r < rays.size() && failures < 5; ++r) {
     const Hit single = traceRay(grid, rays[r], &rayStats);
     const Hit brute = traceRay(none, rays[r]);
@@ -217,6 +229,8 @@ TEST(TracePacket, DegenerateRaysAndSizes) {
   tracePacket(g, {}, none);  // an empty packet is fine
   std::vector<Hit> tooFew(1);
   EXPECT_THROW(tracePacket(g, rays, tooFew), vox::Error);
+  bool oneAnswer[1];
+  EXPECT_THROW(occludedPacket(g, rays, oneAnswer), vox::Error);
 }
 
 }  // namespace

@@ -147,7 +147,10 @@ struct Renderer {
 
   // Ambient, diffuse and Blinn-Phong specular with shadow rays. The normal is turned to face the viewer, so
   // triangles are two-sided and the inside of a sphere is lit like the outside.
-  Vec3 shade(const Ray& ray, const Hit& hit, TraceStats& st) const {
+  // `visible(light index, shadow ray)` answers whether the light is seen; it is asked only for lights in front of
+  // the surface, and only when lights cast shadows.
+  template <typename Visible>
+  Vec3 shade(const Ray& ray, const Hit& hit, Visible&& visible) const {
     const Material& mat = scene.materials[std::min<size_t>(materialOf(scene, accel, hit.prim), scene.materials.size() - 1)];
     const Vec3 p = ray.origin + ray.direction * hit.t;
     Vec3 n = normalOf(accel, ray, hit);
@@ -157,8 +160,8 @@ struct Renderer {
     // Shadow rays start off the surface by a hair relative to the scene and to the magnitude of p.
     const double pMag = std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
     const double eps = 1e-7 * sceneSize + 64 * std::numeric_limits<double>::epsilon() * pMag;
-    for (const Light& light : lights.lights) {
-      const LightSample ls = sampleLight(light, p);
+    for (size_t li = 0; li < lights.lights.size(); ++li) {
+      const LightSample ls = sampleLight(lights.lights[li], p);
       const double nl = dot(n, ls.toLight);
       if (nl <= 0) continue;
       if (lights.castShadows) {
@@ -167,7 +170,7 @@ struct Renderer {
         shadow.direction = ls.toLight;
         shadow.tMin = eps;
         shadow.tMax = ls.distance - eps;
-        if (shadow.tMax > shadow.tMin && occluded(accel, shadow, &st)) continue;
+        if (shadow.tMax > shadow.tMin && !visible(li, shadow)) continue;
       }
       Vec3 c = mat.diffuse * nl;
       if (mat.specular.x > 0 || mat.specular.y > 0 || mat.specular.z > 0) {
@@ -177,6 +180,37 @@ struct Renderer {
       color = color + mul(c, ls.color);
     }
     return color;
+  }
+
+  // The shade mode for a packet of primary rays and their hits: the shadow rays of each light are traced as packets
+  // too (they start near each other and end at one light, or run parallel). Writes RGB for each ray into out.
+  void shadePacket(std::span<const Ray> rays, std::span<const Hit> hits, float (*out)[3], TraceStats& st) const {
+    const size_t lightCount = lights.lights.size();
+    // First pass: collect the shadow rays, per light, with the slot of their answer (ray * lightCount + light).
+    std::vector<std::vector<Ray>> shadowRays(lightCount);
+    std::vector<std::vector<uint32_t>> slots(lightCount);
+    std::vector<uint8_t> seen(rays.size() * lightCount, 1);
+    for (size_t r = 0; r < rays.size(); ++r) {
+      if (!hits[r].valid()) continue;
+      shade(rays[r], hits[r], [&](size_t li, const Ray& shadow) {
+        shadowRays[li].push_back(shadow);
+        slots[li].push_back(uint32_t(r * lightCount + li));
+        return true;
+      });
+    }
+    bool blocked[kMaxPacketRays];
+    for (size_t li = 0; li < lightCount; ++li)
+      for (size_t begin = 0; begin < shadowRays[li].size(); begin += kMaxPacketRays) {
+        const size_t count = std::min<size_t>(kMaxPacketRays, shadowRays[li].size() - begin);
+        occludedPacket(accel, std::span(shadowRays[li]).subspan(begin, count), {blocked, count}, &st);
+        for (size_t i = 0; i < count; ++i) seen[slots[li][begin + i]] = !blocked[i];
+      }
+    // Second pass: shade with the answers.
+    for (size_t r = 0; r < rays.size(); ++r) {
+      const Vec3 c = hits[r].valid() ? shade(rays[r], hits[r], [&](size_t li, const Ray&) { return seen[r * lightCount + li] != 0; })
+                                     : scene.background;
+      out[r][0] = float(c.x), out[r][1] = float(c.y), out[r][2] = float(c.z);
+    }
   }
 
   Vec3 shadeVoxel(const Ray& ray, const CellHit& cell) const {
@@ -202,14 +236,9 @@ struct Renderer {
     return options.mode == RenderMode::Shade || options.mode == RenderMode::Normals || options.mode == RenderMode::Depth;
   }
 
-  // One sample of a nearest-hit mode from its hit; writes `channels` values into out.
-  void fromHit(const Ray& ray, const Hit& hit, float* out, TraceStats& st) const {
+  // One sample of the normals or depth mode from its hit; writes `channels` values into out.
+  void fromHit(const Ray& ray, const Hit& hit, float* out) const {
     switch (options.mode) {
-      case RenderMode::Shade: {
-        const Vec3 c = hit.valid() ? shade(ray, hit, st) : scene.background;
-        out[0] = float(c.x), out[1] = float(c.y), out[2] = float(c.z);
-        break;
-      }
       case RenderMode::Normals: {
         Vec3 c;
         if (hit.valid()) {
@@ -305,13 +334,17 @@ Image traceImage(const Scene& scene, const Accel& accel, const RenderOptions& op
                 }
                 rays[p] = rayFromFrame(options.camera, r.frame, image.width, image.height, sx, sy);
               }
-              if (r.nearestHitMode()) tracePacket(accel, {rays, count}, {hits, count}, &st);
-              for (uint32_t p = 0; p < count; ++p) {
-                float value[3];
-                if (r.nearestHitMode()) r.fromHit(rays[p], hits[p], value, st);
-                else r.walkSample(rays[p], value, st);
-                for (uint32_t c = 0; c < image.channels; ++c) sum[p][c] += value[c];
+              float value[kMaxPacketRays][3];
+              if (r.nearestHitMode()) {
+                tracePacket(accel, {rays, count}, {hits, count}, &st);
+                if (options.mode == RenderMode::Shade) r.shadePacket({rays, count}, {hits, count}, value, st);
+                else
+                  for (uint32_t p = 0; p < count; ++p) r.fromHit(rays[p], hits[p], value[p]);
+              } else {
+                for (uint32_t p = 0; p < count; ++p) r.walkSample(rays[p], value[p], st);
               }
+              for (uint32_t p = 0; p < count; ++p)
+                for (uint32_t c = 0; c < image.channels; ++c) sum[p][c] += value[p][c];
             }
             for (uint32_t p = 0; p < count; ++p) {
               float* out = image.at(px[p], py[p]);

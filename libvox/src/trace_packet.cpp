@@ -1,4 +1,5 @@
-// Slice-by-slice packet traversal (trace_packet.h). Why it returns exactly what traceRay returns, for every ray:
+// Slice-by-slice packet traversal (trace_packet.h). Why it returns exactly what traceRay (and occluded) returns, for
+// every ray:
 // - The nearest hit of a ray lies in a cell the ray passes through, and (exact, sat, bbox grids) its primitive is in
 //   that cell. Each slice's rectangle holds every cell of the slice that any still-walking ray of the packet can
 //   touch: the rays' positions in the slab are bounded by interval arithmetic on a + c s (a, s per ray, c across
@@ -7,7 +8,8 @@
 //   by the same order (closer()), so extra primitives change nothing: the minimum over a superset holding the
 //   nearest hit is the nearest hit.
 // - A ray stops walking after a slice when its best hit, widened by the walker's hit slack, lies before the next
-//   slice's boundary, narrowed by the walker's exit slack: the stop rule of traceRay.
+//   slice's boundary, narrowed by the walker's exit slack: the stop rule of traceRay. An occlusion query stops a ray
+//   at its first hit, as occluded() does; any hit the packet finds is a hit of that ray.
 #include "vox/trace_packet.h"
 
 #include <algorithm>
@@ -193,12 +195,25 @@ bool allBlocksEmpty(const Accel& accel, int k, const int other[2], int64_t slice
   return true;
 }
 
-void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<Hit> hits, TraceStats* stats) {
+// What a packet asks of each ray: its nearest hit (traceRay), or whether anything is hit at all (occluded).
+enum class Query : uint8_t { Nearest, Any };
+
+// The answer of the single-ray query; for Query::Any, a valid Hit (prim 0) stands for "occluded".
+Hit alone(const Accel& accel, const Ray& ray, Query query, TraceStats* stats) {
+  if (query == Query::Nearest) return traceRay(accel, ray, stats);
+  return occluded(accel, ray, stats) ? Hit{0, 0} : Hit{};
+}
+
+// Up to kMaxPacketRays rays. For Query::Any a ray stops at its first hit, and hits[r] is valid exactly when the ray
+// is occluded.
+void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<Hit> hits, Query query,
+                      TraceStats* stats) {
   const int k = sliceAxis(accel, rays);
   if (k < 0) {
-    for (size_t r = 0; r < rays.size(); ++r) hits[r] = traceRay(accel, rays[r], stats);
+    for (size_t r = 0; r < rays.size(); ++r) hits[r] = alone(accel, rays[r], query, stats);
     return;
   }
+  const bool any = query == Query::Any;
   const int other[2] = {(k + 1) % 3, (k + 2) % 3};
   const CellBoundaries& cb = accel.boundaries;
   const int64_t nk = cb.dims[k];
@@ -221,8 +236,12 @@ void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<H
     for (uint32_t id : accel.alwaysTested) {
       double t;
       ++st.tests;
-      if (intersectPrimitive(accel, id, ray, t) && closer(t, id, best[r])) best[r] = {t, id};
+      if (intersectPrimitive(accel, id, ray, t) && closer(t, id, best[r])) {
+        best[r] = {t, id};
+        if (any) break;
+      }
     }
+    if (any && best[r].valid()) continue;  // occluded already: no lane
     const uint32_t l = lanes.count++;
     lanes.ray[l] = r;
     lanes.ox[l] = ray.origin.x, lanes.oy[l] = ray.origin.y, lanes.oz[l] = ray.origin.z;
@@ -337,7 +356,7 @@ void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<H
     // ray afresh, so its answer is the same whatever this packet found so far.
     if (ru[0] <= ru[1] && rv[0] <= rv[1] &&
         uint64_t(ru[1] - ru[0] + 1) * uint64_t(rv[1] - rv[0] + 1) > kMaxCellsPerLane * lanes.count + 8) {
-      for (uint32_t l = 0; l < lanes.count; ++l) best[lanes.ray[l]] = traceRay(accel, rays[lanes.ray[l]], &st);
+      for (uint32_t l = 0; l < lanes.count; ++l) best[lanes.ray[l]] = alone(accel, rays[lanes.ray[l]], query, &st);
       st.rays -= lanes.count;
       break;
     }
@@ -372,7 +391,8 @@ void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<H
             const double t = lanes.t[l];
             if (closer(t, id, h)) {
               h = {t, id};
-              lanes.stopAt[l] = std::min(lanes.tEnd[l], t + (lanes.hitSlack[l] + 1e-9 * std::fabs(t)));
+              // An occlusion query is answered by any hit: the lane retires after this slice.
+              lanes.stopAt[l] = any ? -kInfinity : std::min(lanes.tEnd[l], t + (lanes.hitSlack[l] + 1e-9 * std::fabs(t)));
             }
           }
         }
@@ -404,7 +424,18 @@ void tracePacket(const Accel& accel, std::span<const Ray> rays, std::span<Hit> h
   if (hits.size() < rays.size()) fail<Error>("tracePacket: ", rays.size(), " rays but room for ", hits.size(), " hits");
   for (size_t begin = 0; begin < rays.size(); begin += kMaxPacketRays) {
     const size_t count = std::min<size_t>(kMaxPacketRays, rays.size() - begin);
-    tracePacketChunk(accel, rays.subspan(begin, count), hits.subspan(begin, count), stats);
+    tracePacketChunk(accel, rays.subspan(begin, count), hits.subspan(begin, count), Query::Nearest, stats);
+  }
+}
+
+void occludedPacket(const Accel& accel, std::span<const Ray> rays, std::span<bool> occluded, TraceStats* stats) {
+  if (occluded.size() < rays.size())
+    fail<Error>("occludedPacket: ", rays.size(), " rays but room for ", occluded.size(), " answers");
+  Hit hits[kMaxPacketRays];
+  for (size_t begin = 0; begin < rays.size(); begin += kMaxPacketRays) {
+    const size_t count = std::min<size_t>(kMaxPacketRays, rays.size() - begin);
+    tracePacketChunk(accel, rays.subspan(begin, count), {hits, count}, Query::Any, stats);
+    for (size_t i = 0; i < count; ++i) occluded[begin + i] = hits[i].valid();
   }
 }
 

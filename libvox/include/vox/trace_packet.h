@@ -22,4 +22,8 @@ inline constexpr uint32_t kMaxPacketRays = 64;
 // cut. `stats` counts cells once per packet and tests once per ray (may be null).
 void tracePacket(const Accel& accel, std::span<const Ray> rays, std::span<Hit> hits, TraceStats* stats = nullptr);
 
+// occluded[i] = occluded(accel, rays[i]) (shadow rays), under the same conditions: equal to the brute force on exact,
+// sat and bbox grids, may differ from occluded() on a `center` grid.
+void occludedPacket(const Accel& accel, std::span<const Ray> rays, std::span<bool> occluded, TraceStats* stats = nullptr);
+
 }  // namespace vox

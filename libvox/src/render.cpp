@@ -52,6 +52,7 @@ Vec3 voxelColor(uint32_t count, uint32_t maxCount) {
 
 struct Frame {
   Vec3 dir, right, up;
+  double halfHeight = 1;  // of the image plane at distance 1 (perspective) or in world units (orthographic)
 };
 
 Frame cameraFrame(const Camera& c) {
@@ -61,6 +62,7 @@ Frame cameraFrame(const Camera& c) {
   f.up = cross(f.right, f.dir);
   if (!isFinite(f.dir) || !isFinite(f.right) || length(f.dir) == 0 || length(f.right) == 0)
     fail<UsageError>("camera direction and up must be finite, non-zero and not parallel");
+  f.halfHeight = c.kind == CameraKind::Perspective ? std::tan(c.fovDegrees * M_PI / 360.0) : 0.5 * c.orthoHeight;
   return f;
 }
 
@@ -69,12 +71,11 @@ Ray rayFromFrame(const Camera& camera, const Frame& f, uint32_t width, uint32_t 
   const double sx = 2 * px / width - 1;
   const double sy = 1 - 2 * py / height;
   Ray ray;
+  const double h = f.halfHeight;
   if (camera.kind == CameraKind::Perspective) {
-    const double h = std::tan(camera.fovDegrees * M_PI / 360.0);
     ray.origin = camera.center;
     ray.direction = f.dir + f.right * (sx * h * aspect) + f.up * (sy * h);
   } else {
-    const double h = 0.5 * camera.orthoHeight;
     ray.origin = camera.center + f.right * (sx * h * aspect) + f.up * (sy * h);
     ray.direction = f.dir;
   }

@@ -208,8 +208,8 @@ struct Renderer {
       }
     // Second pass: shade with the answers.
     for (size_t r = 0; r < rays.size(); ++r) {
-      const Vec3 c = hits[r].valid() ? shade(rays[r], hits[r], [&](size_t li, const Ray&) { return seen[r * lightCount + li] != 0; })
-                                     : scene.background;
+      const auto answer = [&](size_t li, const Ray&) { return seen[r * lightCount + li] != 0; };
+      const Vec3 c = hits[r].valid() ? shade(rays[r], hits[r], answer) : scene.background;
       out[r][0] = float(c.x), out[r][1] = float(c.y), out[r][2] = float(c.z);
     }
   }

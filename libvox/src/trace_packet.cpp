@@ -14,7 +14,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 
 // The vector kernel is always inlined into triangleLanes, so GCC's note that passing 32-byte vectors without AVX
@@ -22,6 +21,7 @@
 #pragma GCC diagnostic ignored "-Wpsabi"
 
 #include "cell_range.h"
+#include "mailbox.h"
 #include "triangle_kernel.h"
 #include "vox/error.h"
 
@@ -60,8 +60,9 @@ struct Lanes {
 
   void remove(uint32_t j) {
     const uint32_t e = --count;
-    for (double* v : {ox, oy, oz, dx, dy, dz, tMin, tMax, ok, invK, tolK, stopAt, tEnd, hitSlack, a[0], a[1], s[0], s[1]})
+    for (double* v : {ox, oy, oz, dx, dy, dz, tMin, tMax, ok, invK, tolK, stopAt, tEnd, hitSlack})
       v[j] = v[e];
+    for (int q = 0; q < 2; ++q) a[q][j] = a[q][e], s[q][j] = s[q][e];
     ray[j] = ray[e];
   }
 };
@@ -94,23 +95,9 @@ __attribute__((target_clones("avx2", "default"))) uint64_t triangleLanes(const T
   return bits & live;
 }
 
-// A direct-mapped set of the primitives this packet has tested. A collision only repeats a test, whose result is
-// then not closer() than what it already gave.
-struct PacketMailbox {
-  static constexpr uint32_t kSize = 512;
-  uint32_t ids[kSize];
-  PacketMailbox() { std::memset(ids, 0xff, sizeof(ids)); }
-  bool seen(uint32_t id) {
-    uint32_t& slot = ids[id & (kSize - 1)];
-    if (slot == id) return true;
-    slot = id;
-    return false;
-  }
-};
-
 // The axis along which the packet is sliced: the first ray's largest direction component, provided every ray is
-// finite and travels the same way along it (1 / d_k a normal number) with a slope of at most 2 in the other axes. -1 when there is none (the
-// rays are then traced one by one).
+// finite and travels the same way along it (1 / d_k a normal number) with a slope of at most 2 in the other axes.
+// -1 when there is none (the rays are then traced one by one).
 int sliceAxis(const Accel& accel, std::span<const Ray> rays) {
   const CellBoundaries& cb = accel.boundaries;
   if (accel.kind != AccelKind::Grid || rays.size() < 2 || cb.dims[0] == 0 || cb.dims[1] == 0 || cb.dims[2] == 0)
@@ -269,9 +256,10 @@ void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<H
       const int u = other[q];
       const double slope = ray.direction[u] * invK, at = ray.origin[u] + shift * slope;
       const double p0 = at + cGridLo * slope, p1 = at + cGridHi * slope;
-      const double margin = kCellSlack * cb.cellSize[u] +
-                            64 * kEps * (std::fabs(at) + std::fabs(ray.origin[u]) + std::fabs(shift * slope) +
-                                         std::max(std::fabs(cGridLo), std::fabs(cGridHi)) * std::fabs(slope) + cb.magnitude[u]);
+      const double reach = std::max(std::fabs(cGridLo), std::fabs(cGridHi)) * std::fabs(slope);
+      const double margin =
+          kCellSlack * cb.cellSize[u] +
+          64 * kEps * (std::fabs(at) + std::fabs(ray.origin[u]) + std::fabs(shift * slope) + reach + cb.magnitude[u]);
       beside |= std::max(p0, p1) < cb.b[u].front() - margin || std::min(p0, p1) > cb.b[u].back() + margin;
     }
     if (beside) {
@@ -309,12 +297,13 @@ void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<H
   lanes.padTail();
   const int64_t first = forward ? range[0] : range[1], last = forward ? range[1] : range[0];
 
-  PacketMailbox mailbox;
+  Mailbox<512> mailbox;  // per packet: more primitives than one ray meets
   bool boundsStale = true;
   const int64_t step = forward ? 1 : -1;
   const uint32_t shift = accel.blockShift;
   const int64_t blockMask = (int64_t(1) << shift) - 1;
-  int64_t checkedUpTo = -2;  // the slices of a layer of blocks found not empty run up to this one
+  // The slices up to this one (in the order of travel) lie in a layer of blocks already found not empty.
+  int64_t checkedUpTo = first - step;
   for (int64_t slice = first; lanes.count > 0; slice += step) {
     if (boundsStale) {
       for (int q = 0; q < 2; ++q) {
@@ -330,7 +319,7 @@ void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<H
     }
     // Empty-space skipping: the slices to the end of the current layer of blocks (Accel::blockSlot) are passed over
     // in one step when every block the packet can touch in them is empty.
-    if (shift != 0 && slice != checkedUpTo) {
+    if (shift != 0 && (forward ? slice > checkedUpTo : slice < checkedUpTo)) {
       const int64_t layerEnd = forward ? std::min(slice | blockMask, last) : std::max(slice & ~blockMask, last);
       const double cA = bk[forward ? slice : slice + 1] - c0, cB = bk[forward ? layerEnd + 1 : layerEnd] - c0;
       const auto ru = bounds[0].cells(cb, other[0], cA, cB);
@@ -392,7 +381,8 @@ void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<H
             if (closer(t, id, h)) {
               h = {t, id};
               // An occlusion query is answered by any hit: the lane retires after this slice.
-              lanes.stopAt[l] = any ? -kInfinity : std::min(lanes.tEnd[l], t + (lanes.hitSlack[l] + 1e-9 * std::fabs(t)));
+              const double limit = t + (lanes.hitSlack[l] + 1e-9 * std::fabs(t));
+              lanes.stopAt[l] = any ? -kInfinity : std::min(lanes.tEnd[l], limit);
             }
           }
         }
@@ -410,7 +400,11 @@ void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<H
     }
     if (retire != 0) {
       // Highest first: remove() moves the last lane into the freed one, and lanes above were already handled.
-      for (; retire != 0; retire &= ~(uint64_t(1) << (63 - __builtin_clzll(retire)))) lanes.remove(63 - __builtin_clzll(retire));
+      while (retire != 0) {
+        const uint32_t l = uint32_t(63 - __builtin_clzll(retire));
+        lanes.remove(l);
+        retire &= ~(uint64_t(1) << l);
+      }
       boundsStale = true;
     }
   }

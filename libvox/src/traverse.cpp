@@ -1,7 +1,8 @@
 #include "vox/traverse.h"
 
 #include <algorithm>
-#include <cstring>
+
+#include "mailbox.h"
 
 namespace vox {
 
@@ -196,22 +197,6 @@ void GridWalker::fastForward() {
 
 namespace {
 
-// Per-ray mailbox (Amanatides & Woo 1987; Kirk & Arvo): a direct-mapped cache of the ids tested by this ray. It
-// lives on the stack of the tracing thread, so it needs no synchronisation. A collision only causes a repeated
-// test, which returns the same t, so correctness never depends on it.
-struct Mailbox {
-  static constexpr uint32_t kSize = 64;
-  uint32_t ids[kSize];
-  Mailbox() { std::memset(ids, 0xff, sizeof(ids)); }
-  // True when `id` was already tested; records it otherwise.
-  bool seen(uint32_t id) {
-    uint32_t& slot = ids[id & (kSize - 1)];
-    if (slot == id) return true;
-    slot = id;
-    return false;
-  }
-};
-
 inline void consider(const Accel& accel, uint32_t id, const Ray& ray, Hit& best, TraceStats& st) {
   double t;
   ++st.tests;
@@ -233,7 +218,7 @@ Hit traceRay(const Accel& accel, const Ray& ray, TraceStats* stats) {
   } else {
     for (uint32_t id : accel.alwaysTested) consider(accel, id, ray, best, st);
     GridWalker walker(accel, ray);
-    Mailbox mailbox;
+    Mailbox<64> mailbox;
     WalkCell cell;
     while (walker.next(cell)) {
       ++st.cells;
@@ -273,7 +258,7 @@ bool occluded(const Accel& accel, const Ray& ray, TraceStats* stats) {
       hit = intersectPrimitive(accel, accel.alwaysTested[i], ray, t);
     }
     GridWalker walker(accel, ray);
-    Mailbox mailbox;
+    Mailbox<64> mailbox;
     WalkCell cell;
     while (!hit && walker.next(cell)) {
       ++st.cells;

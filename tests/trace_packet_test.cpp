@@ -185,6 +185,75 @@ TEST(TracePacket, RaysAlongFacesEdgesAndCorners) {
   }
 }
 
+// A tilted mesh whose vertices lie on the integer lattice, hit by orthographic packets whose rays run exactly through
+// vertices and along edges: the packets' outer rays touch triangles of the neighbouring packets only on their
+// boundary, where frustum culling must keep them (a vertex shared by six triangles goes to the smallest id).
+TEST(TracePacket, RaysThroughSharedVerticesAndEdgesAtPacketBorders) {
+  const int n = 16;
+  Scene scene;
+  scene.materials.push_back({});
+  const auto vertex = [](int i, int j) { return Vec3{double(i), double(j), 0.25 * i - 0.5 * j}; };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      scene.triangles.push_back(Triangle{{vertex(i, j), vertex(i + 1, j), vertex(i + 1, j + 1)}});
+      scene.triangles.push_back(Triangle{{vertex(i, j), vertex(i + 1, j + 1), vertex(i, j + 1)}});
+    }
+  for (const std::array<uint32_t, 3>& dims : {std::array<uint32_t, 3>{16, 16, 4}, std::array<uint32_t, 3>{5, 7, 3}}) {
+    VoxelizeOptions o;
+    o.dims = dims;
+    const Grid grid = voxelizeScene(scene, o);
+    const Accel g = buildAccel(scene, grid, AccelKind::Grid);
+    const Accel none = buildAccel(scene, grid, AccelKind::None);
+    for (double step : {1.0, 0.5}) {
+      std::vector<Ray> rays;
+      for (double ty = 0; ty < n; ty += 8 * step)
+        for (double tx = 0; tx < n; tx += 8 * step)
+          for (int y = 0; y < 8; ++y)
+            for (int x = 0; x < 8; ++x) rays.push_back(Ray{{tx + x * step, ty + y * step, 20}, {-0.0, 0, -1}});
+      const PacketCheck check = expectPacketsMatch(g, none, rays, 64, "lattice step " + std::to_string(step));
+      EXPECT_EQ(check.hits, rays.size());
+    }
+  }
+}
+
+// The single-ray walk's hardest stop decision (traverse_test.cpp, NearCoincidentHitsOnBothSidesOfABoundary) in
+// packets: triangle A lies in the slice boundary x = 2, triangle B (smaller ids) one ulp beyond it, in the next
+// slice only; their t are equal or an ulp apart, so a ray must not retire after A's slice without the slacks.
+TEST(TracePacket, NearCoincidentHitsOnBothSidesOfASliceBoundary) {
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<double> u(0.2, 3.8), dir(-0.001, 0.001);
+  int nearerBehind = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const bool forward = trial % 2 == 0;
+    const double xb = forward ? std::nextafter(2.0, 3.0) : std::nextafter(2.0, 1.0);
+    Scene scene;
+    scene.materials.push_back({});
+    const auto square = [&](double x) {
+      scene.triangles.push_back(Triangle{{Vec3{x, 0, 0}, Vec3{x, 4, 0}, Vec3{x, 4, 4}}});
+      scene.triangles.push_back(Triangle{{Vec3{x, 0, 0}, Vec3{x, 4, 4}, Vec3{x, 0, 4}}});
+    };
+    square(xb);   // B, ids 0 and 1
+    square(2.0);  // A, ids 2 and 3
+    scene.triangles.push_back(Triangle{{Vec3{0, 0, 0}, Vec3{4, 0, 0}, Vec3{0, 4, 4}}});  // pins the bounds
+    VoxelizeOptions o;
+    o.dims = {4, 4, 4};
+    o.bounds = Box{{0, 0, 0}, {4, 4, 4}};
+    const Grid grid = voxelizeScene(scene, o);
+    const Accel g = buildAccel(scene, grid, AccelKind::Grid);
+    const Accel none = buildAccel(scene, grid, AccelKind::None);
+    std::vector<Ray> rays;
+    for (int r = 0; r < 256; ++r) {
+      const Vec3 target{2, u(rng), u(rng)};
+      const double dx = 0.5 + (u(rng) - 0.2) / 3.6;
+      const Vec3 d{forward ? dx : -dx, dir(rng), dir(rng)};
+      rays.push_back(Ray{target - d * 1000.0, d});
+    }
+    expectPacketsMatch(g, none, rays, 64, forward ? "B beyond +x" : "B beyond -x");
+    for (const Ray& r : rays) nearerBehind += traceRay(none, r).prim <= 1;
+  }
+  EXPECT_GT(nearerBehind, 100);  // the case really occurs
+}
+
 TEST(TracePacket, OneCellAndLargeGrids) {
   // The small triangles of a random scene (the large ones, and spheres, would fill millions of cells at 2048 a side).
   Scene scene = testing::randomScene(8, 200, 0);

@@ -187,11 +187,12 @@ struct Renderer {
   // too (they start near each other and end at one light, or run parallel). Writes RGB for each ray into out.
   void shadePacket(std::span<const Ray> rays, std::span<const Hit> hits, float (*out)[3], TraceStats& st) const {
     const size_t lightCount = lights.lights.size();
-    // First pass: collect the shadow rays, per light, with the slot of their answer (ray * lightCount + light).
+    // First pass: collect the shadow rays, per light, with the slot of their answer (ray * lightCount + light). It
+    // runs the shading itself, so that the rays asked for are exactly those the second pass will ask about.
     std::vector<std::vector<Ray>> shadowRays(lightCount);
     std::vector<std::vector<uint32_t>> slots(lightCount);
     std::vector<uint8_t> seen(rays.size() * lightCount, 1);
-    for (size_t r = 0; r < rays.size(); ++r) {
+    for (size_t r = 0; r < rays.size() && lights.castShadows; ++r) {
       if (!hits[r].valid()) continue;
       shade(rays[r], hits[r], [&](size_t li, const Ray& shadow) {
         shadowRays[li].push_back(shadow);

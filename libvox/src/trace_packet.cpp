@@ -16,10 +16,6 @@
 #include <cmath>
 #include <limits>
 
-// The vector kernel is always inlined into triangleLanes, so GCC's note that passing 32-byte vectors without AVX
-// changes the calling convention concerns no real call.
-#pragma GCC diagnostic ignored "-Wpsabi"
-
 #include "cell_range.h"
 #include "mailbox.h"
 #include "triangle_kernel.h"

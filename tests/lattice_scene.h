@@ -1,7 +1,8 @@
-// A test scene whose cell boundaries are integers, so that rays exactly along cell faces, edges and through corners
-// can be written down exactly; shared by the walker and packet tests.
+// Test scenes whose cell boundaries are integers, so that rays exactly along cell faces, edges and through corners,
+// and triangles one ulp from a face, can be written down exactly; shared by the walker and packet tests.
 #pragma once
 
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -69,6 +70,45 @@ inline std::vector<Ray> specialRays(int n, double scale = 1, Vec3 offset = {}) {
     add({far, far, far}, {-1, -1, -1});
     add({double(i), -1, -1}, {0, 1, 1});
     add({-1, double(i), 0.5}, {1, 1, 0});
+  }
+  return rays;
+}
+
+// Triangle A covers the square [0, 4]^2 of the cell face x = 2 (ids 2 and 3, in the cells on both sides), triangle B
+// the same square one ulp beyond it in the direction of travel (ids 0 and 1, in one cell only); a fifth triangle
+// pins the bounds to [0, 4]^3. Voxelized exactly into 4x4x4 cells. Rays aimed at the plane from far away see A and B
+// at equal t or an ulp apart, so the nearest hit (ties to the smaller id) is often B, which only the cells after A's
+// reveal: a walk that stops as soon as a hit lies within the current cell misses it.
+struct NearCoincidentPlanes {
+  Scene scene;
+  Grid grid;
+};
+inline NearCoincidentPlanes nearCoincidentPlanes(bool forward) {
+  NearCoincidentPlanes c;
+  c.scene.materials.push_back({});
+  const auto square = [&](double x) {
+    c.scene.triangles.push_back(Triangle{{Vec3{x, 0, 0}, Vec3{x, 4, 0}, Vec3{x, 4, 4}}});
+    c.scene.triangles.push_back(Triangle{{Vec3{x, 0, 0}, Vec3{x, 4, 4}, Vec3{x, 0, 4}}});
+  };
+  square(forward ? std::nextafter(2.0, 3.0) : std::nextafter(2.0, 1.0));  // B
+  square(2.0);                                                              // A
+  c.scene.triangles.push_back(Triangle{{Vec3{0, 0, 0}, Vec3{4, 0, 0}, Vec3{0, 4, 4}}});
+  VoxelizeOptions o;
+  o.dims = {4, 4, 4};
+  o.bounds = Box{{0, 0, 0}, {4, 4, 4}};
+  c.grid = voxelizeScene(c.scene, o);
+  return c;
+}
+// Rays towards random points of the plane x = 2, from 1000 direction lengths away (so that t is large and its ulp
+// dwarfs the one-ulp gap between the planes), travelling in +x when `forward`, nearly along x.
+inline std::vector<Ray> raysAtNearCoincidentPlanes(std::mt19937& rng, bool forward, int count) {
+  std::uniform_real_distribution<double> u(0.2, 3.8), dir(-0.001, 0.001);
+  std::vector<Ray> rays;
+  for (int r = 0; r < count; ++r) {
+    const Vec3 target{2, u(rng), u(rng)};
+    const double dx = 0.5 + (u(rng) - 0.2) / 3.6;
+    const Vec3 d{forward ? dx : -dx, dir(rng), dir(rng)};
+    rays.push_back(Ray{target - d * 1000.0, d});
   }
   return rays;
 }

@@ -221,33 +221,13 @@ TEST(TracePacket, RaysThroughSharedVerticesAndEdgesAtPacketBorders) {
 // slice only; their t are equal or an ulp apart, so a ray must not retire after A's slice without the slacks.
 TEST(TracePacket, NearCoincidentHitsOnBothSidesOfASliceBoundary) {
   std::mt19937 rng(29);
-  std::uniform_real_distribution<double> u(0.2, 3.8), dir(-0.001, 0.001);
   int nearerBehind = 0;
   for (int trial = 0; trial < 40; ++trial) {
     const bool forward = trial % 2 == 0;
-    const double xb = forward ? std::nextafter(2.0, 3.0) : std::nextafter(2.0, 1.0);
-    Scene scene;
-    scene.materials.push_back({});
-    const auto square = [&](double x) {
-      scene.triangles.push_back(Triangle{{Vec3{x, 0, 0}, Vec3{x, 4, 0}, Vec3{x, 4, 4}}});
-      scene.triangles.push_back(Triangle{{Vec3{x, 0, 0}, Vec3{x, 4, 4}, Vec3{x, 0, 4}}});
-    };
-    square(xb);   // B, ids 0 and 1
-    square(2.0);  // A, ids 2 and 3
-    scene.triangles.push_back(Triangle{{Vec3{0, 0, 0}, Vec3{4, 0, 0}, Vec3{0, 4, 4}}});  // pins the bounds
-    VoxelizeOptions o;
-    o.dims = {4, 4, 4};
-    o.bounds = Box{{0, 0, 0}, {4, 4, 4}};
-    const Grid grid = voxelizeScene(scene, o);
-    const Accel g = buildAccel(scene, grid, AccelKind::Grid);
-    const Accel none = buildAccel(scene, grid, AccelKind::None);
-    std::vector<Ray> rays;
-    for (int r = 0; r < 256; ++r) {
-      const Vec3 target{2, u(rng), u(rng)};
-      const double dx = 0.5 + (u(rng) - 0.2) / 3.6;
-      const Vec3 d{forward ? dx : -dx, dir(rng), dir(rng)};
-      rays.push_back(Ray{target - d * 1000.0, d});
-    }
+    const testing::NearCoincidentPlanes c = testing::nearCoincidentPlanes(forward);
+    const Accel g = buildAccel(c.scene, c.grid, AccelKind::Grid);
+    const Accel none = buildAccel(c.scene, c.grid, AccelKind::None);
+    const std::vector<Ray> rays = testing::raysAtNearCoincidentPlanes(rng, forward, 256);
     expectPacketsMatch(g, none, rays, 64, forward ? "B beyond +x" : "B beyond -x");
     for (const Ray& r : rays) nearerBehind += traceRay(none, r).prim <= 1;
   }

@@ -582,39 +582,16 @@ TEST(WalkRobustness, ExactCoverageThroughRoundedCorners) {
 }
 
 TEST(GridVsBruteForce, NearCoincidentHitsOnBothSidesOfABoundary) {
-  // Triangle A lies in the cell face x = 2 (it belongs to cells 1 and 2); triangle B, with the smaller id, lies one
-  // ulp beyond, in cell 2 (or cell 1) only. Their computed t are equal or within an ulp, so the nearest hit (ties to
-  // the smaller id) is often B, which only the cell after A's can reveal: a walk that stops as soon as a hit lies
-  // within the current cell misses it.
+  // See testing::nearCoincidentPlanes: the nearest hit is often B, one ulp beyond the cell face holding A.
   std::mt19937 rng(23);
-  std::uniform_real_distribution<double> u(0.2, 3.8), dir(-0.001, 0.001);
   int differ = 0;
   for (int trial = 0; trial < 60; ++trial) {
     const bool forward = trial % 2 == 0;
-    const double xb = forward ? std::nextafter(2.0, 3.0) : std::nextafter(2.0, 1.0);
-    Scene scene;
-    scene.materials.push_back({});
-    // Two triangles covering the square [0, 4]^2 of the plane at x (inside the grid bounds, so that they are
-    // found through the cells, not through the list of primitives sticking out).
-    auto square = [&](double x) {
-      scene.triangles.push_back(Triangle{{Vec3{x, 0, 0}, Vec3{x, 4, 0}, Vec3{x, 4, 4}}});
-      scene.triangles.push_back(Triangle{{Vec3{x, 0, 0}, Vec3{x, 4, 4}, Vec3{x, 0, 4}}});
-    };
-    square(xb);   // B, ids 0 and 1
-    square(2.0);  // A, ids 2 and 3
-    scene.triangles.push_back(Triangle{{Vec3{0, 0, 0}, Vec3{4, 0, 0}, Vec3{0, 4, 4}}});  // pins the bounds
-    const Grid grid = voxelize(scene, {4, 4, 4}, OverlapMethod::Exact, Box{{0, 0, 0}, {4, 4, 4}});
-    std::vector<Ray> rays;
-    for (int r = 0; r < 200; ++r) {
-      // From far away, so that t is large and its ulp dwarfs the one-ulp gap between the planes.
-      const Vec3 target{2, u(rng), u(rng)};
-      const double dx = 0.5 + (u(rng) - 0.2) / 3.6;
-      const Vec3 d{forward ? dx : -dx, dir(rng), dir(rng)};
-      rays.push_back(Ray{target - d * 1000.0, d});
-    }
-    ASSERT_TRUE(grid.outsidePrims.empty());
-    expectSameHits(scene, grid, rays, forward ? "B beyond +x" : "B beyond -x");
-    const Accel n = buildAccel(scene, grid, AccelKind::None);
+    const testing::NearCoincidentPlanes c = testing::nearCoincidentPlanes(forward);
+    const std::vector<Ray> rays = testing::raysAtNearCoincidentPlanes(rng, forward, 200);
+    ASSERT_TRUE(c.grid.outsidePrims.empty());
+    expectSameHits(c.scene, c.grid, rays, forward ? "B beyond +x" : "B beyond -x");
+    const Accel n = buildAccel(c.scene, c.grid, AccelKind::None);
     for (const Ray& r : rays) differ += traceRay(n, r).prim <= 1;
   }
   // The case must really occur, or the test proves nothing.

@@ -26,7 +26,6 @@ namespace vox {
 namespace {
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Largest slice rectangle, in cells per walking ray, worth visiting as a packet (a ray alone visits 1 to 3 cells
 // per slice, each at several times the cost of a rectangle cell).
 constexpr uint64_t kMaxCellsPerLane = 4;
@@ -65,12 +64,12 @@ struct Lanes {
 
 // One triangle against every lane, four at a time. Compiled twice, for AVX2 and for the baseline, and picked at
 // load time: the arithmetic is IEEE double either way (no contraction), so both give the scalar test's t. Lanes past
-// `count` hold zeros or retired rays (Lanes::padTail); their results are never read. Returns the lanes hit, as bits.
+// `count` hold zeros or retired rays (Lanes::padTail); their results are never read. Returns the lanes hit, as bits;
+// lanes.t is meaningful only for those.
 __attribute__((target_clones("avx2", "default"))) uint64_t triangleLanes(const TriangleData& tri, Lanes& lanes) {
   using kernel::Double4;
   const double v0[3] = {tri.v0.x, tri.v0.y, tri.v0.z}, e1[3] = {tri.e1.x, tri.e1.y, tri.e1.z},
                e2[3] = {tri.e2.x, tri.e2.y, tri.e2.z}, n[3] = {tri.n.x, tri.n.y, tri.n.z};
-  const Double4 nan = {kNaN, kNaN, kNaN, kNaN};
   uint64_t bits = 0;
   for (uint32_t j = 0; j < lanes.count; j += 4) {
     Double4 ox, oy, oz, dx, dy, dz, tMin, tMax, t;
@@ -83,8 +82,7 @@ __attribute__((target_clones("avx2", "default"))) uint64_t triangleLanes(const T
     __builtin_memcpy(&tMin, lanes.tMin + j, sizeof(tMin));
     __builtin_memcpy(&tMax, lanes.tMax + j, sizeof(tMax));
     const auto hit = kernel::triangleHit(v0, e1, e2, n, ox, oy, oz, dx, dy, dz, tMin, tMax, t);
-    const Double4 result = hit ? t : nan;
-    __builtin_memcpy(lanes.t + j, &result, sizeof(result));
+    __builtin_memcpy(lanes.t + j, &t, sizeof(t));
     bits |= uint64_t((hit[0] & 1) | (hit[1] & 2) | (hit[2] & 4) | (hit[3] & 8)) << j;
   }
   const uint64_t live = lanes.count == 64 ? ~uint64_t(0) : (uint64_t(1) << lanes.count) - 1;
@@ -234,28 +232,27 @@ void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<H
     const double invK = 1.0 / dk, absInv = std::fabs(invK);
     lanes.ok[l] = ok;
     lanes.invK[l] = invK;
-    lanes.tolK[l] = (kCellSlack * cb.cellSize[k] + 64 * kEps * (std::fabs(ok) + cb.magnitude[k])) * absInv;
-    double scale = 0;
-    for (int a = 0; a < 3; ++a) scale = std::max(scale, std::fabs(ray.origin[a]) + cb.magnitude[a]);
+    lanes.tolK[l] = positionTolerance(cb, k, ok) * absInv;
     // At least RayAxes::hitSlack: divided by |d_k| instead of the largest |d|.
-    const double hitSlack = (kCellSlack * cb.minCell + 64 * kEps * scale) * absInv;
-    const double tEnd = ray.tMax + (hitSlack + 1e-9 * std::fabs(ray.tMax));  // the walker's last parameter
+    const double hitSlack = hitSlackLength(cb, ray.origin) * absInv;
+    const double tEnd = ray.tMax + hitSlackAt(hitSlack, ray.tMax);  // the walker's last parameter
     lanes.hitSlack[l] = hitSlack;
     lanes.tEnd[l] = tEnd;
-    lanes.stopAt[l] = best[r].valid() ? std::min(tEnd, best[r].t + (hitSlack + 1e-9 * std::fabs(best[r].t))) : tEnd;
+    lanes.stopAt[l] = best[r].valid() ? std::min(tEnd, best[r].t + hitSlackAt(hitSlack, best[r].t)) : tEnd;
     const double pStart = ok + ray.tMin * dk, pEnd = ok + tEnd * dk;
     // A ray that passes beside the grid box needs no lane (its a + c s stays off the grid's range on some axis over
     // the grid's slab range; the margin covers the rounding, as in AxisBounds::cells).
     const double shift = c0 - ok, cGridLo = bk[0] - c0, cGridHi = bk[nk] - c0;
+    double slope[2], at[2];
     bool beside = false;
     for (int q = 0; q < 2; ++q) {
       const int u = other[q];
-      const double slope = ray.direction[u] * invK, at = ray.origin[u] + shift * slope;
-      const double p0 = at + cGridLo * slope, p1 = at + cGridHi * slope;
-      const double reach = std::max(std::fabs(cGridLo), std::fabs(cGridHi)) * std::fabs(slope);
+      slope[q] = ray.direction[u] * invK;
+      at[q] = ray.origin[u] + shift * slope[q];
+      const double p0 = at[q] + cGridLo * slope[q], p1 = at[q] + cGridHi * slope[q];
+      const double reach = std::max(std::fabs(cGridLo), std::fabs(cGridHi)) * std::fabs(slope[q]);
       const double margin =
-          kCellSlack * cb.cellSize[u] +
-          64 * kEps * (std::fabs(at) + std::fabs(ray.origin[u]) + std::fabs(shift * slope) + reach + cb.magnitude[u]);
+          positionTolerance(cb, u, std::fabs(at[q]) + std::fabs(ray.origin[u]) + std::fabs(shift * slope[q]) + reach);
       beside |= std::max(p0, p1) < cb.b[u].front() - margin || std::min(p0, p1) > cb.b[u].back() + margin;
     }
     if (beside) {
@@ -268,21 +265,20 @@ void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<H
       if (std::isfinite(p)) originMax[k] = std::max(originMax[k], std::fabs(p));
     for (int q = 0; q < 2; ++q) {
       const int u = other[q];
-      const double slope = ray.direction[u] * invK, at = ray.origin[u] + shift * slope;
-      lanes.s[q][l] = slope;
-      lanes.a[q][l] = at;
-      bounds[q].magnitude = std::max(bounds[q].magnitude, std::fabs(at) + std::fabs(ray.origin[u]) +
-                                                              std::fabs(shift) * std::fabs(slope));
-      bounds[q].sMax = std::max(bounds[q].sMax, std::fabs(slope));
+      lanes.s[q][l] = slope[q];
+      lanes.a[q][l] = at[q];
+      bounds[q].magnitude = std::max(bounds[q].magnitude, std::fabs(at[q]) + std::fabs(ray.origin[u]) +
+                                                              std::fabs(shift) * std::fabs(slope[q]));
+      bounds[q].sMax = std::max(bounds[q].sMax, std::fabs(slope[q]));
       originMax[u] = std::max(originMax[u], std::fabs(ray.origin[u]));
     }
   }
   for (int q = 0; q < 2; ++q) {
     const int u = other[q];
-    bounds[q].tolPos = kCellSlack * cb.cellSize[u] + 64 * kEps * (originMax[u] + cb.magnitude[u]);
+    bounds[q].tolPos = positionTolerance(cb, u, originMax[u]);
   }
   // Slices to walk, in order of travel: from `first` to `last`.
-  const double padK = kCellSlack * cb.cellSize[k] + 64 * kEps * (originMax[k] + cb.magnitude[k]);
+  const double padK = positionTolerance(cb, k, originMax[k]);
   const auto range = cellRangeOnAxis(nk, cb.cellsPerUnit[k], [bk](int64_t i) { return bk[i]; }, pLo - padK, pHi + padK);
   if (range[0] > range[1]) lanes.count = 0;
   if (lanes.count == 0) {
@@ -377,7 +373,7 @@ void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<H
             if (closer(t, id, h)) {
               h = {t, id};
               // An occlusion query is answered by any hit: the lane retires after this slice.
-              const double limit = t + (lanes.hitSlack[l] + 1e-9 * std::fabs(t));
+              const double limit = t + hitSlackAt(lanes.hitSlack[l], t);
               lanes.stopAt[l] = any ? -kInfinity : std::min(lanes.tEnd[l], limit);
             }
           }

@@ -8,7 +8,6 @@ namespace vox {
 
 namespace {
 
-constexpr double kEps = std::numeric_limits<double>::epsilon();
 constexpr double kRel = kWalkRel;
 
 // Largest i in [0, n-1] with b[i] <= c (c below the grid gives 0, above gives n-1). The multiplication only guesses;
@@ -39,13 +38,9 @@ int64_t cellAbove(const CellBoundaries& cb, int a, double c) {
 
 RayAxes rayAxes(const CellBoundaries& cells, const Ray& ray) {
   RayAxes ax;
-  double scale = 0;
   for (int a = 0; a < 3; ++a) {
     const double d = ray.direction[a];
-    const double mag = std::fabs(ray.origin[a]) + cells.magnitude[a];
-    scale = std::max(scale, mag);
-    // Positional slack per axis: a fraction of the cell plus the rounding of coordinates of this magnitude.
-    ax.tolPos[a] = kCellSlack * cells.cellSize[a] + 64 * kEps * mag;
+    ax.tolPos[a] = positionTolerance(cells, a, ray.origin[a]);
     ax.inv[a] = 1.0 / d;
     ax.divide[a] = !std::isnormal(ax.inv[a]);
     ax.tol[a] = d == 0 ? 0 : ax.divide[a] ? ax.tolPos[a] / std::fabs(d) : ax.tolPos[a] * std::fabs(ax.inv[a]);
@@ -54,10 +49,15 @@ RayAxes rayAxes(const CellBoundaries& cells, const Ray& ray) {
   // larger slack only makes the stop rule more careful.
   const Vec3& d = ray.direction;
   const double dirMax = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
-  ax.hitSlack = (kCellSlack * cells.minCell + 64 * kEps * scale) / dirMax;
+  ax.hitSlack = hitSlackLength(cells, ray.origin) / dirMax;
   return ax;
 }
 
+namespace {
+
+// The parameters [tLo, tHi] within which `ray` (finite, nonzero direction, restricted to [tMin, tMax]) can be inside
+// the closed grid box, widened by the tolerances; `entryAxis` is the axis whose slab sets tLo (-1 when tMin does).
+// False when the ray misses the box.
 bool gridSpan(const CellBoundaries& cells, const Ray& ray, const RayAxes& ax, double& tLo, double& tHi,
               int& entryAxis) {
   // Slab test against the closed grid box [b(0), b(n)].
@@ -84,6 +84,8 @@ bool gridSpan(const CellBoundaries& cells, const Ray& ray, const RayAxes& ax, do
   }
   return tLo <= tHi;
 }
+
+}  // namespace
 
 void GridWalker::init(const CellBoundaries& cells, const Ray& ray) {
   done_ = true;

@@ -13,6 +13,7 @@
 //   by nx + ny + nz + 3 steps, since every step moves one index one cell in the direction of travel.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -31,6 +32,22 @@ inline constexpr double kWalkRel = 16 * std::numeric_limits<double>::epsilon(); 
 // visit the cells across it. Costs an extra cell visit about once per million crossings.
 inline constexpr double kCellSlack = 1e-6;
 
+// Positional tolerance on axis a, in world units, for coordinates up to `coord` in magnitude: a fraction of a cell
+// plus the rounding of coordinates that large (the grid's own included).
+inline double positionTolerance(const CellBoundaries& cells, int a, double coord) {
+  return kCellSlack * cells.cellSize[a] + 64 * std::numeric_limits<double>::epsilon() * (std::fabs(coord) + cells.magnitude[a]);
+}
+// Bound on the error of a primitive hit's position, world units, for a ray from `origin`; divided by a direction
+// component no larger than the largest it is a bound in ray parameter units (RayAxes::hitSlack).
+inline double hitSlackLength(const CellBoundaries& cells, const Vec3& origin) {
+  double scale = 0;
+  for (int a = 0; a < 3; ++a) scale = std::max(scale, std::fabs(origin[a]) + cells.magnitude[a]);
+  return kCellSlack * cells.minCell + 64 * std::numeric_limits<double>::epsilon() * scale;
+}
+// Bound on the error of a primitive hit's t at parameter t, from the part independent of t: what decides when a
+// walk may stop.
+inline double hitSlackAt(double hitSlack, double t) { return hitSlack + 1e-9 * std::fabs(t); }
+
 // The per-axis constants of one ray's walk.
 struct RayAxes {
   double inv[3];      // 1 / d
@@ -43,15 +60,9 @@ struct RayAxes {
   // multiplication instead of a division per step; error at most 2 ulps more than the quotient, far inside kWalkRel),
   // else (b - o) / d. Only for a nonzero d.
   double crossing(int a, double b, double o, double d) const { return divide[a] ? (b - o) / d : (b - o) * inv[a]; }
-  // Bound on the error of a primitive hit's t at parameter t, used to decide when a walk may stop.
-  double hitSlackAt(double t) const { return hitSlack + 1e-9 * std::fabs(t); }
+  double hitSlackAt(double t) const { return vox::hitSlackAt(hitSlack, t); }
 };
 RayAxes rayAxes(const CellBoundaries& cells, const Ray& ray);
-
-// The parameters [tLo, tHi] within which `ray` (finite, nonzero direction, restricted to [tMin, tMax]) can be inside
-// the closed grid box, widened by the tolerances; `entryAxis` is the axis whose slab sets tLo (-1 when tMin does).
-// False when the ray misses the box.
-bool gridSpan(const CellBoundaries& cells, const Ray& ray, const RayAxes& ax, double& tLo, double& tHi, int& entryAxis);
 
 struct WalkCell {
   std::array<uint32_t, 3> idx;

@@ -76,6 +76,8 @@ expect 1 "unknown accel" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.png" --acc
 expect 1 "samples 0" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.png" --samples 0 -q
 expect 1 "fov 180" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.png" --fov 180 -q
 expect 1 "eye without look-at" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.png" --eye 0 0 1 -q
+expect 1 "NaN eye" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.png" --eye nan 0 1 --look-at 0 0 0 -q
+grep -q "must be finite" "$WORK/err.txt" || fail "NaN eye: message does not say the eye must be finite"
 expect 1 "unknown image format" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.xyz" -q
 expect 1 "no output" -- "$TRACE" "$WORK/s.vgrid" -q
 

@@ -45,6 +45,7 @@ vox::Camera resolveCamera(const Options& opt, const vox::GridFile& file) {
     cam.direction = vec(opt.lookAt) - vec(opt.eye);
     cam.up = scene.up;
     cam.fovDegrees = scene.kind == CameraKind::Perspective ? scene.fovDegrees : 45;
+    if (!isFinite(cam.center) || !isFinite(vec(opt.lookAt))) fail<UsageError>("--eye and --look-at must be finite");
     if (!(length(cam.direction) > 0)) fail<UsageError>("--eye and --look-at must differ");
   }
   if (!opt.up.empty()) cam.up = vec(opt.up);

@@ -1,7 +1,7 @@
 // The MIT 6.837 (Fall 2004) text scene format; grammar in seed-scenes/6837/README.md ("Scene file grammar").
 // Tokens are whitespace-separated words, keywords case-sensitive, no comments. Every error names file:line.
-// TriangleMesh OBJ files are read by a strict v/f reader of our own (double precision, line-numbered errors):
-// the course files hold only `v x y z` and `f i j k` lines, and the course's reader accepts nothing more.
+// TriangleMesh OBJ files are read by the OBJ reader shared with the OBJ importer (obj_reader.h: double precision,
+// line-numbered errors); only their vertices and faces are used (the course's reader knows nothing else).
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -13,6 +13,7 @@
 #include <string_view>
 #include <vector>
 
+#include "obj_reader.h"
 #include "vox/error.h"
 #include "vox/import.h"
 
@@ -68,70 +69,6 @@ std::optional<long long> parseInteger(std::string_view s) {
   const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
   if (ec != std::errc() || end != s.data() + s.size()) return std::nullopt;
   return value;
-}
-
-// ---- strict OBJ (v/f) reader for TriangleMesh ----
-
-struct ObjMesh {
-  std::vector<Vec3> vertices;
-  std::vector<std::array<uint32_t, 3>> faces;  // 0-based, validated
-};
-
-// Accepts `v x y z` and `f a b c ...` (polygons fan-triangulated, `a/b/c` forms use the vertex index, negative
-// indices count back from the last vertex read); comments, blank lines and other statements are skipped.
-ObjMesh readStrictObj(const std::string& path) {
-  const std::string text = readWholeFile(path, "mesh file");
-  ObjMesh mesh;
-  struct PendingFace {
-    std::vector<long long> index;  // as written
-    long long verticesSoFar;
-    int line;
-  };
-  std::vector<PendingFace> pending;
-  std::istringstream lines(text);
-  std::string lineText;
-  int lineNumber = 0;
-  while (std::getline(lines, lineText)) {
-    ++lineNumber;
-    std::istringstream words(lineText);
-    std::string keyword;
-    if (!(words >> keyword) || keyword[0] == '#') continue;
-    if (keyword == "v") {
-      double xyz[3];
-      for (double& c : xyz) {
-        std::string word;
-        if (!(words >> word)) fail<InputError>(path, ":", lineNumber, ": vertex needs 3 coordinates");
-        const auto value = parseDouble(word);
-        if (!value) fail<InputError>(path, ":", lineNumber, ": bad number '", word, "'");
-        c = *value;
-      }
-      mesh.vertices.push_back({xyz[0], xyz[1], xyz[2]});
-    } else if (keyword == "f") {
-      PendingFace face{{}, static_cast<long long>(mesh.vertices.size()), lineNumber};
-      std::string word;
-      while (words >> word) {
-        const std::string_view head = std::string_view(word).substr(0, word.find('/'));
-        const auto value = parseInteger(head);
-        if (!value) fail<InputError>(path, ":", lineNumber, ": bad face index '", word, "'");
-        face.index.push_back(*value);
-      }
-      if (face.index.size() < 3) fail<InputError>(path, ":", lineNumber, ": face needs at least 3 vertices");
-      pending.push_back(std::move(face));
-    }
-    // Anything else (vn, vt, o, g, s, usemtl, mtllib) carries nothing a voxelizer needs.
-  }
-  const long long count = static_cast<long long>(mesh.vertices.size());
-  for (const PendingFace& face : pending) {
-    std::vector<uint32_t> resolved;
-    for (long long i : face.index) {
-      const long long zeroBased = i > 0 ? i - 1 : face.verticesSoFar + i;
-      if (i == 0 || zeroBased < 0 || zeroBased >= count)
-        fail<InputError>(path, ":", face.line, ": face index ", i, " out of range (", count, " vertices)");
-      resolved.push_back(static_cast<uint32_t>(zeroBased));
-    }
-    for (size_t k = 1; k + 1 < resolved.size(); ++k) mesh.faces.push_back({resolved[0], resolved[k], resolved[k + 1]});
-  }
-  return mesh;
 }
 
 // ---- scene parser ----
@@ -609,14 +546,17 @@ class CourseParser {
     if (it == meshes_.end()) {
       std::error_code ec;
       if (!std::filesystem::is_regular_file(file, ec)) failAt(name, "cannot open mesh file '", file.string(), "'");
-      it = meshes_.emplace(key, readStrictObj(file.string())).first;
+      const std::string objPath = file.string();
+      it = meshes_.emplace(key, parseObj(readTextFile(objPath, "mesh file", kMaxObjFileBytes), objPath)).first;
+      for (const std::string& w : it->second.warnings) warn(w);
     }
-    const ObjMesh& mesh = it->second;
+    const ObjData& mesh = it->second;
     const uint32_t material = currentMaterial(t);
     std::vector<Vec3> world(mesh.vertices.size());
     for (size_t i = 0; i < world.size(); ++i) world[i] = transformPoint(m, mesh.vertices[i]);
-    out.triangles.reserve(out.triangles.size() + mesh.faces.size());
-    for (const auto& f : mesh.faces) out.triangles.push_back({{world[f[0]], world[f[1]], world[f[2]]}, material});
+    // No reserve(size() + n) here: growing by exactly n per mesh made thousands of instances quadratic;
+    // push_back's geometric growth keeps the total linear.
+    for (const auto& f : mesh.triangles) out.triangles.push_back({{world[f[0]], world[f[1]], world[f[2]]}, material});
   }
 
   std::string path_;
@@ -627,7 +567,7 @@ class CourseParser {
   Scene scene_;
   std::optional<uint32_t> currentMaterial_;
   bool warnedNoMaterial_ = false;
-  std::map<std::string, ObjMesh> meshes_;
+  std::map<std::string, ObjData> meshes_;
   int nesting_ = 0;
 };
 

@@ -1,129 +1,106 @@
-// Wavefront OBJ through tinyobjloader (Debian's 2.0.0rc10, built with float coordinates: real_t = float, so
-// coordinates are rounded to single precision). Quirks relied on and worked around:
-// - with triangulate = true, quads and polygons come back as triangles (num_face_vertices all 3);
-// - it does not reject a face index past the last vertex: it only adds "Vertex indices out of bounds" to its
-//   warnings (naming the file's last line), and silently drops such quads; we check every index ourselves and
-//   rescan the file for the offending line so the error names it.
-#include <tiny_obj_loader.h>
-
+// Wavefront OBJ scenes through our own reader (obj_reader.h): double-precision coordinates, exact errors.
+// Material libraries (`mtllib`) are resolved relative to the OBJ file's folder:
+// - a library that does not exist is a warning, and its materials fall back to the default (a downloaded OBJ often
+//   comes without its .mtl);
+// - a library outside that folder (an absolute path, `..`, or a symbolic link leading out) or one that is not a
+//   regular file (a directory, a FIFO, a device) is an InputError naming the OBJ file and line: an OBJ file must not
+//   make the tools read other files, and a FIFO would block forever.
+// Materials: every material of every library, in file order, then one default white material when a face has none
+// (no `usemtl`, or a name that no library defines: a warning).
 #include <filesystem>
-#include <fstream>
-#include <sstream>
+#include <map>
+#include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
+#include "obj_reader.h"
 #include "vox/error.h"
 #include "vox/import.h"
 
 namespace vox {
 namespace {
 
-// Finds the first `f` line whose vertex index falls outside the file's `vertexCount` vertices (negative indices
-// count back from the vertices read so far). Returns 0 when none is found.
-int findBadFaceLine(const std::string& path, long long vertexCount) {
-  std::ifstream in(path);
-  std::string text;
-  int line = 0;
-  long long seen = 0;
-  while (std::getline(in, text)) {
-    ++line;
-    std::istringstream words(text);
-    std::string keyword;
-    if (!(words >> keyword)) continue;
-    if (keyword == "v") {
-      ++seen;
-    } else if (keyword == "f") {
-      std::string word;
-      while (words >> word) {
-        long long i = 0;
-        try {
-          i = std::stoll(word.substr(0, word.find('/')));
-        } catch (const std::exception&) {
-          return line;
-        }
-        const long long zeroBased = i > 0 ? i - 1 : seen + i;
-        if (i == 0 || zeroBased < 0 || zeroBased >= vertexCount) return line;
-      }
+namespace fs = std::filesystem;
+
+// Whether `p` (canonical) lies inside the folder `folder` (canonical).
+bool isInside(const fs::path& p, const fs::path& folder) {
+  const fs::path rel = p.lexically_relative(folder);
+  return !rel.empty() && *rel.begin() != ".." && *rel.begin() != ".";
+}
+
+// The library file `lib` names, or nullopt (with a warning) when it does not exist.
+std::optional<fs::path> resolveLibrary(const std::string& objPath, const ObjLibrary& lib, Scene& scene) {
+  const fs::path written(lib.name);
+  const fs::path normal = written.lexically_normal();
+  if (written.is_absolute() || (!normal.empty() && *normal.begin() == ".."))
+    fail<InputError>(objPath, ":", lib.line, ": material library ", quotedWord(lib.name),
+                     " is outside the OBJ file's folder");
+  fs::path folder = fs::path(objPath).parent_path();
+  if (folder.empty()) folder = ".";
+  const fs::path file = folder / written;
+  std::error_code ec;
+  if (!fs::exists(file, ec)) {
+    scene.warnings.push_back(objPath + ":" + std::to_string(lib.line) + ": material library " + quotedWord(lib.name) +
+                             " not found; its materials are drawn in default white");
+    return std::nullopt;
+  }
+  const fs::path canonicalFile = fs::canonical(file, ec);
+  const fs::path canonicalFolder = fs::canonical(folder, ec);
+  if (ec || !isInside(canonicalFile, canonicalFolder))
+    fail<InputError>(objPath, ":", lib.line, ": material library ", quotedWord(lib.name),
+                     " is outside the OBJ file's folder");
+  if (!fs::is_regular_file(canonicalFile, ec))
+    fail<InputError>(objPath, ":", lib.line, ": material library ", quotedWord(lib.name), " is not a regular file");
+  return canonicalFile;
+}
+
+// Reads every library once, appending its materials to scene.materials; returns each name's last definition.
+std::map<std::string, uint32_t> loadLibraries(const std::string& objPath, const ObjData& obj, Scene& scene) {
+  std::map<std::string, uint32_t> byName;
+  std::set<fs::path> read;
+  for (const ObjLibrary& lib : obj.libraries) {
+    const auto file = resolveLibrary(objPath, lib, scene);
+    if (!file || !read.insert(*file).second) continue;
+    // Messages name the library as the OBJ file names it, beside the OBJ file.
+    const std::string shown = (fs::path(objPath).parent_path() / lib.name).string();
+    const std::string text = readTextFile(file->string(), "material library", kMaxMtlFileBytes);
+    for (Material& m : parseMtl(text, shown, scene.warnings)) {
+      byName[m.name] = static_cast<uint32_t>(scene.materials.size());
+      scene.materials.push_back(std::move(m));
     }
   }
-  return 0;
-}
-
-[[noreturn]] void failBadIndex(const std::string& path, long long vertexCount) {
-  const int line = findBadFaceLine(path, vertexCount);
-  if (line > 0) fail<InputError>(path, ":", line, ": face index out of range (", vertexCount, " vertices)");
-  fail<InputError>(path, ": face index out of range (", vertexCount, " vertices)");
-}
-
-std::string trimmed(std::string s) {
-  while (!s.empty() && (s.back() == '\n' || s.back() == '\r' || s.back() == ' ')) s.pop_back();
-  return s;
+  return byName;
 }
 
 }  // namespace
 
 Scene importObj(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) fail<InputError>(path, ": cannot open OBJ file");
-
-  tinyobj::attrib_t attrib;
-  std::vector<tinyobj::shape_t> shapes;
-  std::vector<tinyobj::material_t> objMaterials;
-  std::string warn, err;
-  const std::string folder = std::filesystem::path(path).parent_path().string();
-  const std::string mtlDir = folder.empty() ? std::string("./") : folder + "/";
-  const bool ok = tinyobj::LoadObj(&attrib, &shapes, &objMaterials, &warn, &err, path.c_str(), mtlDir.c_str(),
-                                   /*triangulate=*/true, /*default_vcols_fallback=*/false);
-  const long long vertexCount = static_cast<long long>(attrib.vertices.size() / 3);
-  if (!ok) fail<InputError>(path, ": ", err.empty() ? std::string("cannot read OBJ file") : trimmed(err));
-  if (warn.find("Vertex indices out of bounds") != std::string::npos ||
-      warn.find("invalid vertex index") != std::string::npos)
-    failBadIndex(path, vertexCount);
-
+  const ObjData obj = parseObj(readTextFile(path, "OBJ file", kMaxObjFileBytes), path);
   Scene scene;
-  for (const auto& m : objMaterials) {
-    Material out;
-    out.name = m.name;
-    out.diffuse = {m.diffuse[0], m.diffuse[1], m.diffuse[2]};
-    out.specular = {m.specular[0], m.specular[1], m.specular[2]};
-    out.exponent = m.shininess;
-    out.indexOfRefraction = m.ior;
-    scene.materials.push_back(out);
-  }
-  const uint32_t defaultMaterial = static_cast<uint32_t>(scene.materials.size());
-  bool usesDefault = false;
+  scene.warnings = obj.warnings;
+  const std::map<std::string, uint32_t> byName = loadLibraries(path, obj, scene);
 
-  for (const auto& shape : shapes) {
-    const auto& mesh = shape.mesh;
-    size_t offset = 0;
-    for (size_t f = 0; f < mesh.num_face_vertices.size(); ++f) {
-      const size_t n = mesh.num_face_vertices[f];
-      if (offset + n > mesh.indices.size()) fail<InputError>(path, ": shape '", shape.name, "': face list is short");
-      Vec3 corner[256];
-      if (n < 3 || n > 256) fail<InputError>(path, ": shape '", shape.name, "': face with ", n, " vertices");
-      for (size_t k = 0; k < n; ++k) {
-        const int vi = mesh.indices[offset + k].vertex_index;
-        if (vi < 0 || vi >= vertexCount) failBadIndex(path, vertexCount);
-        const auto* p = &attrib.vertices[3 * static_cast<size_t>(vi)];
-        corner[k] = {p[0], p[1], p[2]};
-      }
-      uint32_t material = defaultMaterial;
-      const int id = f < mesh.material_ids.size() ? mesh.material_ids[f] : -1;
-      if (id >= 0 && static_cast<size_t>(id) < objMaterials.size())
-        material = static_cast<uint32_t>(id);
-      else
-        usesDefault = true;
-      // Triangulation is on, so n is 3; a fan keeps any other polygon whole should that ever change.
-      for (size_t k = 1; k + 1 < n; ++k) scene.triangles.push_back({{corner[0], corner[k], corner[k + 1]}, material});
-      offset += n;
-    }
+  const uint32_t defaultMaterial = static_cast<uint32_t>(scene.materials.size());
+  std::vector<uint32_t> slot(obj.materialNames.size(), defaultMaterial);
+  for (size_t i = 0; i < slot.size(); ++i) {
+    const auto it = byName.find(obj.materialNames[i]);
+    if (it != byName.end())
+      slot[i] = it->second;
+    else
+      scene.warnings.push_back(path + ":" + std::to_string(obj.materialLines[i]) + ": material " +
+                               quotedWord(obj.materialNames[i]) + " is not defined; default white is used");
+  }
+
+  bool usesDefault = false;
+  scene.triangles.reserve(obj.triangles.size());
+  for (size_t i = 0; i < obj.triangles.size(); ++i) {
+    const auto& f = obj.triangles[i];
+    const uint32_t m = obj.triangleMaterial[i] == kNoObjMaterial ? defaultMaterial : slot[obj.triangleMaterial[i]];
+    usesDefault |= m == defaultMaterial;
+    scene.triangles.push_back({{obj.vertices[f[0]], obj.vertices[f[1]], obj.vertices[f[2]]}, m});
   }
   if (usesDefault || scene.materials.empty()) scene.materials.push_back(Material{"default"});
-
-  std::istringstream lines(warn);
-  std::string line;
-  while (std::getline(lines, line))
-    if (!trimmed(line).empty()) scene.warnings.push_back(path + ": " + trimmed(line));
   return scene;
 }
 

@@ -45,8 +45,30 @@ std::optional<Box> sceneBounds(const Scene& scene) {
   return out;
 }
 
+namespace {
+
+// Materials are checked like geometry: a value that is NaN, infinite or out of range would be written into a grid
+// file that the tools then refuse to read, or shade to NaN.
+void validateMaterial(const Material& m, size_t i, const std::string& source) {
+  const auto colour = [&](const Vec3& c, const char* what) {
+    if (!isFinite(c)) fail<InputError>(source, ": material ", i, " '", m.name, "': ", what, " is NaN or infinite");
+  };
+  colour(m.diffuse, "diffuse colour");
+  colour(m.specular, "specular colour");
+  colour(m.reflective, "reflective colour");
+  colour(m.transparent, "transparent colour");
+  if (!std::isfinite(m.exponent) || !(m.exponent >= 0))
+    fail<InputError>(source, ": material ", i, " '", m.name, "': exponent ", m.exponent, " is not a finite number >= 0");
+  if (!std::isfinite(m.indexOfRefraction) || !(m.indexOfRefraction > 0))
+    fail<InputError>(source, ": material ", i, " '", m.name, "': index of refraction ", m.indexOfRefraction,
+                     " is not a finite positive number");
+}
+
+}  // namespace
+
 void validateScene(const Scene& scene, const std::string& source) {
   const size_t materials = scene.materials.size();
+  for (size_t i = 0; i < materials; ++i) validateMaterial(scene.materials[i], i, source);
   auto checkMaterial = [&](uint32_t m, const char* what, size_t i) {
     if (m >= materials) fail<InputError>(source, ": ", what, " ", i, ": material index ", m, " out of range");
   };

@@ -90,7 +90,8 @@ std::optional<Box> sceneBounds(const Scene& scene);
 // A triangle whose vertices are collinear or coincide (zero area).
 bool isDegenerate(const Triangle& t);
 // Throws InputError naming `source` when any coordinate, radius or matrix entry is NaN or infinite, a radius is
-// not positive, or a material index is out of range.
+// not positive, a material index is out of range, or a material holds a NaN or infinite colour, an exponent that is
+// not a finite number >= 0, or an index of refraction that is not a finite positive number.
 void validateScene(const Scene& scene, const std::string& source);
 // A perspective camera looking at the centre of `bounds` from +z, framing it; used when a scene has none.
 Camera defaultCamera(const Box& bounds);

@@ -110,6 +110,38 @@ TEST(GridFile, ParserChecksStructureEvenWithAValidChecksum) {
   Grid badStart = grid;
   badStart.cellStart.back() += 1;
   EXPECT_THROW(decodeGridFile(encodeGridFile(scene, badStart), "x"), InputError);
+  // Issue 9: offsets that run backwards ([0, 1, 0] with no references) crashed every tool: the primitive range of
+  // cell 0 was walked before the offsets were checked.
+  Grid backwards = grid;
+  backwards.cellKeys = {0, 1};
+  backwards.cellStart = {0, 1, 0};
+  backwards.primIds.clear();
+  EXPECT_THROW(decodeGridFile(encodeGridFile(scene, backwards), "x"), InputError);
+  Grid pastEnd = grid;
+  pastEnd.cellKeys = {0, 1};
+  pastEnd.cellStart = {0, 5, 1};
+  pastEnd.primIds = {0};
+  EXPECT_THROW(decodeGridFile(encodeGridFile(scene, pastEnd), "x"), InputError);
+  // A camera that cannot form an image and a singular ellipsoid are the file's fault (exit 2, named), not usage
+  // errors found later while tracing.
+  Scene zeroCamera = scene;
+  zeroCamera.camera = Camera{};
+  zeroCamera.camera->direction = {0, 0, 0};
+  try {
+    decodeGridFile(encodeGridFile(zeroCamera, grid), "cam.vgrid");
+    FAIL() << "zero camera direction accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cam.vgrid: camera direction is zero"), std::string::npos) << e.what();
+  }
+  Scene parallelUp = scene;
+  parallelUp.camera = Camera{};
+  parallelUp.camera->up = {0, 0, -2};
+  EXPECT_THROW(decodeGridFile(encodeGridFile(parallelUp, grid), "x"), InputError);
+  Scene singular = scene;
+  Sphere flat;
+  flat.transform = scaling({1, 0, 1});
+  singular.spheres.push_back(flat);
+  EXPECT_THROW(decodeGridFile(encodeGridFile(singular, grid), "x"), InputError);
   Scene badMaterial = scene;
   badMaterial.triangles[0].material = 9;
   EXPECT_THROW(decodeGridFile(encodeGridFile(badMaterial, grid), "x"), InputError);

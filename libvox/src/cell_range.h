@@ -15,15 +15,23 @@ template <typename BoundaryFn>
 std::array<int64_t, 2> cellRangeOnAxis(int64_t n, double scale, const BoundaryFn& b, double lo, double hi) {
   const double b0 = b(0);
   if (!(hi >= b0) || !(lo <= b(n))) return {1, 0};
-  // Clamped in double before the conversion, so far-away coordinates cannot overflow the integer.
-  auto guess = [&](double x) {
+  // Clamped in double before the conversion, so far-away coordinates cannot overflow the integer. A scale that is
+  // not finite (bounds of subnormal width) or a NaN product gives no usable guess: bisect instead.
+  const bool usable = std::isfinite(scale);
+  auto guess = [&](double x, auto&& below) {
     const double g = std::floor((x - b0) * scale);
-    return g < 0 ? int64_t(0) : (g > double(n - 1) ? n - 1 : int64_t(g));
+    if (usable && g == g) return g < 0 ? int64_t(0) : (g > double(n - 1) ? n - 1 : int64_t(g));
+    int64_t a = 0, z = n - 1;  // smallest c in [0, n-1] with !below(c), or n-1
+    while (a < z) {
+      const int64_t mid = a + (z - a) / 2;
+      if (below(mid)) a = mid + 1; else z = mid;
+    }
+    return a;
   };
-  int64_t first = guess(lo);
+  int64_t first = guess(lo, [&](int64_t c) { return b(c + 1) < lo; });
   while (first > 0 && b(first) >= lo) --first;
   while (first < n - 1 && b(first + 1) < lo) ++first;
-  int64_t last = guess(hi);
+  int64_t last = guess(hi, [&](int64_t c) { return b(c + 1) <= hi; });
   while (last < n - 1 && b(last + 1) <= hi) ++last;
   while (last > 0 && b(last) > hi) --last;
   return {first, last};

@@ -9,6 +9,7 @@
 
 #include "vox/atomic_file.h"
 #include "vox/error.h"
+#include "vox/input_file.h"
 
 static_assert(std::endian::native == std::endian::little, "grid files are little-endian; big-endian hosts need byte swaps");
 
@@ -334,8 +335,12 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
       bad("cell keys not sorted or outside the grid");
   if (grid.cellStart.size() != grid.cellKeys.size() + 1) bad("cell offsets do not match the cell count");
   if (grid.cellStart.front() != 0 || grid.cellStart.back() != grid.primIds.size()) bad("cell offsets do not cover the references");
+  // Every offset is checked before any primitive range is walked: offsets that run backwards or past the
+  // references would otherwise send the walk outside primIds.
+  for (size_t c = 0; c + 1 < grid.cellStart.size(); ++c)
+    if (grid.cellStart[c + 1] <= grid.cellStart[c] || grid.cellStart[c + 1] > grid.primIds.size())
+      bad("cell " + std::to_string(c) + ": offsets empty, backwards or past the references");
   for (size_t c = 0; c + 1 < grid.cellStart.size(); ++c) {
-    if (grid.cellStart[c + 1] <= grid.cellStart[c]) bad("empty or negative cell");
     for (uint64_t k = grid.cellStart[c]; k < grid.cellStart[c + 1]; ++k)
       if (grid.primIds[k] >= bounded || (k > grid.cellStart[c] && grid.primIds[k] <= grid.primIds[k - 1]))
         bad("primitive ids not ascending or out of range");
@@ -344,6 +349,9 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
     if (id >= bounded) bad("outside primitive id out of range");
   for (size_t c = 0; c < grid.solidKeys.size(); ++c)
     if (grid.solidKeys[c] >= cells || (c > 0 && grid.solidKeys[c] <= grid.solidKeys[c - 1])) bad("solid cells not sorted");
+  // The same checks as at import (singular ellipsoid transforms, cameras that cannot form an image, materials),
+  // so a grid file that passes here traces and exports.
+  validateScene(scene, name);
   return out;
 }
 
@@ -359,16 +367,8 @@ void writeGridFile(const std::string& path, const Scene& scene, const Grid& grid
 }
 
 GridFile readGridFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail<InputError>(path, ": cannot open file");
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  if (size < 0) fail<InputError>(path, ": cannot read file");
-  in.seekg(0);
-  std::string bytes(size_t(size), '\0');
-  in.read(bytes.data(), size);
-  if (!in) fail<InputError>(path, ": read error");
-  return decodeGridFile(bytes, path);
+  // readInputFile refuses non-regular files and sizes the memory budget cannot hold, before reading them whole.
+  return decodeGridFile(readInputFile(path, "grid file"), path);
 }
 
 }  // namespace vox

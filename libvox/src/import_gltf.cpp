@@ -16,6 +16,7 @@
 #include <tiny_gltf.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -23,10 +24,12 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "vox/error.h"
 #include "vox/import.h"
+#include "vox/input_file.h"
 
 namespace vox {
 namespace {
@@ -81,6 +84,18 @@ Mat4 fromQuaternion(double x, double y, double z, double w) {
   return r;
 }
 
+// Without a scene every node that is nobody's child is a root.
+std::vector<int> parentlessNodes(const tinygltf::Model& model) {
+  std::vector<bool> isChild(model.nodes.size(), false);
+  for (const auto& node : model.nodes)
+    for (int c : node.children)
+      if (c >= 0 && static_cast<size_t>(c) < isChild.size()) isChild[static_cast<size_t>(c)] = true;
+  std::vector<int> roots;
+  for (size_t i = 0; i < isChild.size(); ++i)
+    if (!isChild[i]) roots.push_back(static_cast<int>(i));
+  return roots;
+}
+
 class GltfReader {
  public:
   GltfReader(std::string path, const tinygltf::Model& model) : path_(std::move(path)), model_(model) {}
@@ -93,13 +108,7 @@ class GltfReader {
       if (sceneIndex < 0 || static_cast<size_t>(sceneIndex) >= model_.scenes.size()) sceneIndex = 0;
       roots = model_.scenes[static_cast<size_t>(sceneIndex)].nodes;
     } else {
-      // No scenes: every node that is nobody's child is a root.
-      std::vector<bool> isChild(model_.nodes.size(), false);
-      for (const auto& node : model_.nodes)
-        for (int c : node.children)
-          if (c >= 0 && static_cast<size_t>(c) < isChild.size()) isChild[static_cast<size_t>(c)] = true;
-      for (size_t i = 0; i < isChild.size(); ++i)
-        if (!isChild[i]) roots.push_back(static_cast<int>(i));
+      roots = parentlessNodes(model_);
     }
     std::vector<bool> onPath(model_.nodes.size(), false);
     for (int root : roots) visitNode(root, Mat4::identity(), onPath, 0);
@@ -399,29 +408,219 @@ class GltfReader {
   size_t visits_ = 0;
 };
 
+// Nesting deeper than this is refused before the JSON reaches tinygltf, whose recursive parser (nlohmann::json)
+// overflows the stack at some ten thousand levels. Real glTF nests a handful of levels; extras a few more.
+constexpr int kMaxJsonDepth = 256;
+
+// The deepest nesting of [ and { in `json`, ignoring brackets inside strings (with their escapes).
+int jsonDepth(std::string_view json) {
+  int depth = 0, deepest = 0;
+  bool inString = false;
+  for (size_t i = 0; i < json.size(); ++i) {
+    const char c = json[i];
+    if (inString) {
+      if (c == '\\')
+        ++i;
+      else if (c == '"')
+        inString = false;
+    } else if (c == '"') {
+      inString = true;
+    } else if (c == '[' || c == '{') {
+      deepest = std::max(deepest, ++depth);
+      if (deepest > kMaxJsonDepth) return deepest;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return deepest;
+}
+
+// The JSON text of a .gltf, or the JSON chunk of a .glb (whose header tinygltf checks again).
+std::string_view jsonPart(const std::string& bytes, bool binary) {
+  if (!binary) return bytes;
+  uint32_t chunkLength = 0;
+  if (bytes.size() < 20) return {};
+  std::memcpy(&chunkLength, bytes.data() + 12, 4);
+  return std::string_view(bytes).substr(20, chunkLength);
+}
+
+// tinygltf's file callbacks, narrowed: every external file (buffer or image uri) must resolve inside the glTF's
+// own folder and be a regular file. tinygltf also looks in the current folder, and its default path expansion
+// runs wordexp; neither happens here. The first refusal is kept for the error message.
+struct FolderGuard {
+  std::string gltfPath;
+  std::string refusal;
+};
+
+bool guardedFileExists(const std::string& path, void* user) {
+  auto& guard = *static_cast<FolderGuard*>(user);
+  try {
+    requireRegularFile(requireInsideFolder(guard.gltfPath, path), "glTF buffer or image");
+    return true;
+  } catch (const Error& e) {
+    if (guard.refusal.empty()) guard.refusal = e.what();
+    return false;
+  }
+}
+
+std::string keepPath(const std::string& path, void*) { return path; }
+
+bool guardedReadWholeFile(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+  if (!guardedFileExists(path, user)) {
+    if (err) *err = static_cast<FolderGuard*>(user)->refusal;
+    return false;
+  }
+  try {
+    const std::string bytes = readInputFile(path, "glTF buffer or image");
+    out->assign(bytes.begin(), bytes.end());
+    return true;
+  } catch (const Error& e) {
+    auto& guard = *static_cast<FolderGuard*>(user);
+    if (guard.refusal.empty()) guard.refusal = e.what();
+    if (err) *err = e.what();
+    return false;
+  }
+}
+
+bool refuseWrite(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  if (err) *err = "writing is not allowed while importing";
+  return false;
+}
+
+// Triangles a primitive declares, from its accessor counts alone (the reader checks the accessors later).
+double declaredTriangles(const tinygltf::Model& model, const tinygltf::Primitive& prim) {
+  const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+  int accessor = prim.indices;
+  if (accessor < 0) {
+    const auto pos = prim.attributes.find("POSITION");
+    accessor = pos == prim.attributes.end() ? -1 : pos->second;
+  }
+  if (accessor < 0 || size_t(accessor) >= model.accessors.size()) return 0;
+  const double n = double(model.accessors[size_t(accessor)].count);
+  if (mode == TINYGLTF_MODE_TRIANGLES) return std::floor(n / 3);
+  if (mode == TINYGLTF_MODE_TRIANGLE_STRIP || mode == TINYGLTF_MODE_TRIANGLE_FAN) return std::max(0.0, n - 2);
+  return 0;
+}
+
+// Nodes instance meshes, and a small file can ask for billions of triangles (100 nodes x 100 primitives of a
+// shared accessor). Their total over the node hierarchy is counted first, memoised per node so shared subtrees
+// cost nothing, and refused before any triangle is made when it cannot fit.
+class InstanceCounter {
+ public:
+  explicit InstanceCounter(const tinygltf::Model& model) : model_(model), memo_(model.nodes.size(), -1) {}
+
+  double node(int index, int depth) {
+    // Out-of-range, cyclic and too deep hierarchies are the reader's to report; they add nothing here.
+    if (index < 0 || size_t(index) >= model_.nodes.size() || depth > 256) return 0;
+    double& memo = memo_[size_t(index)];
+    if (memo >= 0) return memo;
+    memo = 0;  // a cycle back to this node adds nothing
+    const tinygltf::Node& n = model_.nodes[size_t(index)];
+    double total = 0;
+    if (n.mesh >= 0 && size_t(n.mesh) < model_.meshes.size())
+      for (const auto& prim : model_.meshes[size_t(n.mesh)].primitives) total += declaredTriangles(model_, prim);
+    for (int child : n.children) total += node(child, depth + 1);
+    memo = total;
+    return total;
+  }
+
+ private:
+  const tinygltf::Model& model_;
+  std::vector<double> memo_;
+};
+
+void checkInstancedTriangles(const std::string& path, const tinygltf::Model& model) {
+  InstanceCounter count(model);
+  double total = 0;
+  if (!model.scenes.empty()) {
+    int sceneIndex = model.defaultScene;
+    if (sceneIndex < 0 || size_t(sceneIndex) >= model.scenes.size()) sceneIndex = 0;
+    for (int root : model.scenes[size_t(sceneIndex)].nodes) total += count.node(root, 0);
+  } else {
+    for (int root : parentlessNodes(model)) total += count.node(root, 0);
+  }
+  // A triangle costs its world-space copy (sizeof(Triangle)) and, in the grid, at least one reference.
+  checkMemory(total * double(sizeof(Triangle) + 8), path,
+              "instancing " + std::to_string(uint64_t(std::min(total, 1e19))) + " triangles");
+}
+
+// The uris of buffers and images, checked before tinygltf reads any: each must name a regular file inside the
+// glTF's folder. (The file callbacks above check again what tinygltf actually opens.) Percent-escapes are decoded
+// first, as tinygltf does, so "%2E%2E/" is "../".
+std::string percentDecoded(const std::string& uri) {
+  std::string out;
+  for (size_t i = 0; i < uri.size(); ++i) {
+    if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit(static_cast<unsigned char>(uri[i + 1])) &&
+        std::isxdigit(static_cast<unsigned char>(uri[i + 2]))) {
+      out += char(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
+      i += 2;
+    } else {
+      out += uri[i];
+    }
+  }
+  return out;
+}
+
+void checkExternalUris(const std::string& path, std::string_view json) {
+  const nlohmann::json doc = nlohmann::json::parse(json.begin(), json.end(), nullptr, /*allow_exceptions=*/false);
+  if (!doc.is_object()) return;  // tinygltf reports malformed JSON
+  for (const char* kind : {"buffers", "images"}) {
+    const auto list = doc.find(kind);
+    if (list == doc.end() || !list->is_array()) continue;
+    for (size_t i = 0; i < list->size(); ++i) {
+      const auto& item = (*list)[i];
+      if (!item.is_object() || !item.contains("uri") || !item["uri"].is_string()) continue;
+      const std::string uri = item["uri"].get<std::string>();
+      if (uri.rfind("data:", 0) == 0) continue;
+      try {
+        requireRegularFile(resolveInsideFolder(path, percentDecoded(uri)), "glTF buffer or image");
+      } catch (const InputError& e) {
+        fail<InputError>(path, ": ", std::string(kind, std::strlen(kind) - 1), " ", i, ": uri '", quoteInput(uri),
+                         "': ", std::string(e.what()).substr(std::string(e.what()).rfind(": ") + 2));
+      }
+    }
+  }
+}
+
+// tinygltf's messages are several lines; ours are one.
+std::string oneLine(const std::string& text) {
+  std::string out;
+  std::istringstream lines(text);
+  std::string line;
+  while (std::getline(lines, line))
+    if (!trimmed(line).empty()) out += (out.empty() ? "" : "; ") + trimmed(line);
+  return out;
+}
+
 }  // namespace
 
 Scene importGltf(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail<InputError>(path, ": cannot open glTF file");
-  char magic[4] = {};
-  in.read(magic, 4);
-  const bool binary = in.gcount() == 4 && std::memcmp(magic, "glTF", 4) == 0;
-  in.close();
+  const std::string bytes = readInputFile(path, "glTF file");
+  const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+  if (jsonDepth(jsonPart(bytes, binary)) > kMaxJsonDepth)
+    fail<InputError>(path, ": JSON nested deeper than ", kMaxJsonDepth, " levels");
 
+  checkExternalUris(path, jsonPart(bytes, binary));
+  FolderGuard guard{path, {}};
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(skipImage, nullptr);
+  loader.SetFsCallbacks({guardedFileExists, keepPath, guardedReadWholeFile, refuseWrite, &guard});
   tinygltf::Model model;
   std::string err, warn;
-  const bool ok = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
-                         : loader.LoadASCIIFromFile(&model, &err, &warn, path);
-  if (!ok) fail<InputError>(path, ": ", err.empty() ? std::string("cannot read glTF file") : trimmed(err));
+  std::error_code ec;
+  const std::string baseDir = std::filesystem::weakly_canonical(std::filesystem::absolute(path), ec).parent_path().string();
+  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+  const bool ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, unsigned(bytes.size()), baseDir)
+                         : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), baseDir);
+  if (!guard.refusal.empty()) throw InputError(guard.refusal);
+  if (!ok) fail<InputError>(path, ": ", err.empty() ? std::string("cannot read glTF file") : quoteInput(oneLine(err), 300));
+  checkInstancedTriangles(path, model);
 
   Scene scene = GltfReader(path, model).read();
   std::istringstream lines(warn);
   std::string line;
   while (std::getline(lines, line))
-    if (!trimmed(line).empty()) scene.warnings.push_back(path + ": " + trimmed(line));
+    if (!trimmed(line).empty()) scene.warnings.push_back(path + ": " + quoteInput(trimmed(line), 300));
   return scene;
 }
 

@@ -6,12 +6,15 @@
 
 #include "vox/error.h"
 #include "vox/import.h"
+#include "vox/input_file.h"
 
 namespace vox {
 
 Scene loadScene(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  // Before any importer opens it: a folder named d.txt must not import as an empty scene, and a FIFO would block.
+  requireRegularFile(path, "scene file");
   Scene scene;
   if (ext == ".txt")
     scene = importCourseScene(path);

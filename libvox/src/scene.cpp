@@ -103,8 +103,21 @@ void validateScene(const Scene& scene, const std::string& source) {
   for (const auto& l : scene.lights)
     if (!isFinite(l.direction) || !isFinite(l.position) || !isFinite(l.color))
       fail<InputError>(source, ": light is NaN or infinite");
-  if (scene.camera && (!isFinite(scene.camera->center) || !isFinite(scene.camera->direction)))
+  if (scene.camera) validateCamera(*scene.camera, source);
+}
+
+void validateCamera(const Camera& c, const std::string& source) {
+  if (!isFinite(c.center) || !isFinite(c.direction) || !isFinite(c.up) || !std::isfinite(c.fovDegrees) ||
+      !std::isfinite(c.orthoHeight))
     fail<InputError>(source, ": camera is NaN or infinite");
+  // The image frame (DESIGN.md camera convention) needs a direction and an up that span a plane.
+  if (!(length(c.direction) > 0)) fail<InputError>(source, ": camera direction is zero");
+  if (!(length(cross(normalize(c.direction), c.up)) > 0))
+    fail<InputError>(source, ": camera up is zero or parallel to its direction");
+  if (c.kind == CameraKind::Perspective && !(c.fovDegrees > 0 && c.fovDegrees < 180))
+    fail<InputError>(source, ": camera field of view ", c.fovDegrees, " is not between 0 and 180 degrees");
+  if (c.kind == CameraKind::Orthographic && !(c.orthoHeight > 0))
+    fail<InputError>(source, ": orthographic camera size ", c.orthoHeight, " is not positive");
 }
 
 Camera defaultCamera(const Box& bounds) {

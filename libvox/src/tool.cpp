@@ -5,6 +5,7 @@
 #include <new>
 
 #include "vox/error.h"
+#include "vox/input_file.h"
 
 namespace vox {
 
@@ -16,8 +17,16 @@ const char* versionString() {
 #endif
 }
 
+namespace {
+constexpr size_t kMaxMessageBytes = 600;
+}  // namespace
+
 int runTool(const std::string& toolName, const std::function<int()>& body) {
-  auto report = [&](const char* message) { std::fprintf(stderr, "%s: error: %s\n", toolName.c_str(), message); };
+  // One line, whatever the message holds: a library message can quote hostile input (a 10 MB data URI, control
+  // bytes), so it is escaped and cut here as a last guard.
+  auto report = [&](const char* message) {
+    std::fprintf(stderr, "%s: error: %s\n", toolName.c_str(), quoteInput(message, kMaxMessageBytes).c_str());
+  };
   try {
     return body();
   } catch (const OutputError& e) {
@@ -33,7 +42,9 @@ int runTool(const std::string& toolName, const std::function<int()>& body) {
     report(e.what());
     return kExitBadInput;
   } catch (const std::bad_alloc&) {
-    report("out of memory");
+    // Every allocation that input drives is estimated and refused before it is made (LimitError); this is the
+    // guard for what the estimates missed, so it says what to try.
+    report("out of memory (the request was larger than estimated; try a smaller grid or --threads 1)");
     return kExitBadInput;
   } catch (const std::exception& e) {
     report(e.what());

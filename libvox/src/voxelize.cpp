@@ -38,12 +38,17 @@ Box paddedBounds(Box b) {
 // The boundary formula b(i) = lo + (hi - lo) * i / n need not give b(n) == hi in floating point, which would leave a
 // sliver of the bounds (and primitives lying on the top face) outside every cell. Nudge hi up by ulps until the
 // formula reproduces it exactly; the change is a few ulps at most.
+// Bounds the user gave make a failure a usage error; bounds taken from the scene make it the scene's (exit 2).
+template <typename E>
 void alignUpperBounds(Grid& grid) {
   for (int a = 0; a < 3; ++a) {
     int steps = 0;
     while (cellBoundary(grid.bounds, grid.dims, a, grid.dims[a]) != grid.bounds.hi[a]) {
       grid.bounds.hi.at(a) = std::nextafter(grid.bounds.hi[a], HUGE_VAL);
-      if (++steps > 4096) fail<UsageError>("bounds on axis ", a, " cannot be divided into ", grid.dims[a], " cells");
+      if (++steps > 4096)
+        fail<E>("bounds [", grid.bounds.lo[a], ", ", grid.bounds.hi[a], "] on axis ", "xyz"[a],
+                " cannot be divided into ", grid.dims[a], " cells in double precision (coordinates of very "
+                "different magnitudes?)");
     }
   }
 }
@@ -122,10 +127,13 @@ double estimateReferences(const Scene& scene, const Grid& grid) {
   double h = HUGE_VAL;
   for (int a = 0; a < 3; ++a) h = std::min(h, (grid.bounds.hi[a] - grid.bounds.lo[a]) / grid.dims[a]);
   double total = 0;
+  // bbox takes the whole range; center takes the cells whose centres lie in the footprint, at most the range too.
+  const bool wholeRange = grid.method == OverlapMethod::BBox || grid.method == OverlapMethod::Center;
   auto add = [&](const Box& box, double area, double perimeter) {
     const auto r = rangeOf(grid, box);
     if (!r) return;
-    total += std::min(double(r->count()), 3 * area / (h * h) + 2 * perimeter / h + 8);
+    const double range = double(r->count());
+    total += wholeRange ? range : std::min(range, 3 * area / (h * h) + 2 * perimeter / h + 8);
   };
   for (const auto& t : scene.triangles)
     add(triangleBounds(t), triangleArea(t),
@@ -140,19 +148,28 @@ double estimateReferences(const Scene& scene, const Grid& grid) {
 
 }  // namespace
 
+namespace {
+// The bounds' extents divided by the largest one (each in (0, 1]).
+Vec3 relativeExtents(const Box& bounds) {
+  const Vec3 e = bounds.hi - bounds.lo;
+  const double largest = std::max({e.x, e.y, e.z});
+  return {e.x / largest, e.y / largest, e.z / largest};
+}
+}  // namespace
+
 std::array<uint32_t, 3> dimsForResolution(const Box& bounds, uint32_t resolution) {
   if (resolution == 0 || resolution > kMaxCellsPerAxis)
     fail<UsageError>("resolution ", resolution, " out of range (1 to ", kMaxCellsPerAxis, ")");
-  const Vec3 e = bounds.hi - bounds.lo;
-  const double cell = std::max({e.x, e.y, e.z}) / resolution;
+  // Extents relative to the largest, so that bounds of subnormal width cannot underflow the cell size to 0.
+  const Vec3 e = relativeExtents(bounds);
   std::array<uint32_t, 3> dims;
   for (int a = 0; a < 3; ++a)
-    dims[a] = uint32_t(std::clamp<double>(std::round(e[a] / cell), 1, resolution));
+    dims[a] = uint32_t(std::clamp<double>(std::round(e[a] * resolution), 1, resolution));
   return dims;
 }
 
 std::array<uint32_t, 3> defaultDims(const Box& bounds, size_t boundedPrimitives) {
-  const Vec3 e = bounds.hi - bounds.lo;
+  const Vec3 e = relativeExtents(bounds);
   const double target = std::max(1.0, kCellsPerPrimitive * double(boundedPrimitives));
   const double cell = std::cbrt(e.x * e.y * e.z / target);
   std::array<uint32_t, 3> dims;
@@ -172,6 +189,10 @@ Grid planGrid(const Scene& scene, const VoxelizeOptions& options) {
     grid.bounds = b;
   } else if (const auto b = sceneBounds(scene)) {
     grid.bounds = paddedBounds(*b);
+    for (int a = 0; a < 3; ++a)
+      if (!std::isfinite(grid.bounds.hi[a] - grid.bounds.lo[a]))
+        fail<InputError>("scene bounds [", grid.bounds.lo[a], ", ", grid.bounds.hi[a], "] on axis ", "xyz"[a],
+                         " are wider than the largest double: no grid can divide them");
   } else {
     grid.bounds = {{0, 0, 0}, {1, 1, 1}};
     grid.dims = {1, 1, 1};
@@ -185,7 +206,10 @@ Grid planGrid(const Scene& scene, const VoxelizeOptions& options) {
     grid.dims = defaultDims(grid.bounds, scene.boundedCount());
   }
   checkDims(grid.dims);
-  alignUpperBounds(grid);
+  if (options.bounds)
+    alignUpperBounds<UsageError>(grid);
+  else
+    alignUpperBounds<InputError>(grid);
   return grid;
 }
 

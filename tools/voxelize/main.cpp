@@ -9,6 +9,7 @@
 #include "vox/fill.h"
 #include "vox/grid_file.h"
 #include "vox/import.h"
+#include "vox/input_file.h"
 #include "vox/progress.h"
 #include "vox/voxelize.h"
 
@@ -26,11 +27,6 @@ struct Options {
   vox::cli::CommonOptions common;
 };
 
-uint64_t physicalMemory() {
-  const long pages = ::sysconf(_SC_PHYS_PAGES), size = ::sysconf(_SC_PAGE_SIZE);
-  return pages > 0 && size > 0 ? uint64_t(pages) * uint64_t(size) : (16ull << 30);
-}
-
 int run(const Options& opt) {
   using namespace vox;
   const auto start = std::chrono::steady_clock::now();
@@ -40,8 +36,7 @@ int run(const Options& opt) {
   if (!opt.grid.empty()) vo.dims = std::array<uint32_t, 3>{opt.grid[0], opt.grid[1], opt.grid[2]};
   if (opt.resolution) vo.resolution = opt.resolution;
   if (!opt.bounds.empty()) vo.bounds = Box{{opt.bounds[0], opt.bounds[1], opt.bounds[2]}, {opt.bounds[3], opt.bounds[4], opt.bounds[5]}};
-  // Leave a quarter of the machine for the rest of the system.
-  vo.memoryLimitBytes = physicalMemory() / 4 * 3;
+  vo.memoryLimitBytes = memoryBudgetBytes();
 
   const Scene scene = loadScene(opt.scene);
   if (!opt.common.quiet)
@@ -52,9 +47,16 @@ int run(const Options& opt) {
     return true;
   };
   VoxelizeStats stats;
-  Grid grid = voxelizeScene(scene, vo, &stats);
-  bar.finish();
-  if (opt.fill) fillSolid(grid, vo.memoryLimitBytes);
+  Grid grid;
+  try {
+    grid = voxelizeScene(scene, vo, &stats);
+    bar.finish();
+    if (opt.fill) fillSolid(grid, vo.memoryLimitBytes);
+  } catch (const LimitError& e) {
+    fail<LimitError>(opt.scene, ": ", e.what());  // what the scene asks for is named with the scene
+  } catch (const InputError& e) {
+    fail<InputError>(opt.scene, ": ", e.what());
+  }
   if (!grid.outsidePrims.empty() && !opt.common.quiet)
     std::fprintf(stderr, "vox-voxelize: warning: %s: %zu primitives stick out of the given bounds (traced separately)\n",
                  opt.scene.c_str(), grid.outsidePrims.size());

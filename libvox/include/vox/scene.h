@@ -93,6 +93,10 @@ bool isDegenerate(const Triangle& t);
 // not positive, a material index is out of range, or a material holds a NaN or infinite colour, an exponent that is
 // not a finite number >= 0, or an index of refraction that is not a finite positive number.
 void validateScene(const Scene& scene, const std::string& source);
+// Throws InputError naming `source` when the camera cannot form an image: non-finite values, a zero direction, an
+// up that is zero or parallel to the direction, a field of view outside (0, 180) degrees, a size that is not
+// positive. Part of validateScene.
+void validateCamera(const Camera& camera, const std::string& source);
 // A perspective camera looking at the centre of `bounds` from +z, framing it; used when a scene has none.
 Camera defaultCamera(const Box& bounds);
 

@@ -1,0 +1,38 @@
+// Reading untrusted input files: only regular files, only inside the folder a scene names, never more bytes than
+// memory allows. Shared by the importers and the grid reader so that each check exists once.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace vox {
+
+// Bytes the tools may spend on one request: three quarters of physical memory, or VOX_MEMORY_LIMIT_MB when that
+// environment variable holds a positive number (tests use it to reach the limits quickly).
+uint64_t memoryBudgetBytes();
+
+// Throws LimitError "WHERE: WHAT needs N MiB, more than the M MiB allowed" when `bytes` exceeds memoryBudgetBytes().
+// Called before an allocation whose size the input decides.
+void checkMemory(double bytes, const std::string& where, const std::string& what);
+
+// Reads a whole regular file. Throws InputError naming `path` when it is missing, a folder, a FIFO or device
+// (which could block forever or never end), unreadable, or larger than the memory budget allows (LimitError).
+// `what` names the file's role in messages ("scene file", "grid file").
+std::string readInputFile(const std::string& path, const char* what);
+
+// Throws InputError unless `path` names a regular file (checked before any importer opens it).
+void requireRegularFile(const std::string& path, const char* what);
+
+// Resolves `reference` (a relative path written inside `referrer`, such as a glTF buffer uri or an OBJ mtllib)
+// against the referrer's folder. Throws InputError naming the referrer when the reference is absolute or, after
+// resolving "..", symbolic links included, leaves that folder.
+std::string resolveInsideFolder(const std::string& referrer, const std::string& reference);
+// The canonical form of `path` (absolute, or relative to the current folder) when it lies inside the folder of
+// `referrer`; throws InputError naming the referrer otherwise.
+std::string requireInsideFolder(const std::string& referrer, const std::string& path);
+
+// `text` made safe to quote in a one-line message: control bytes (below 0x20, and 0x7f) escaped as \xHH, and cut
+// to about `maxBytes` with "..." when longer.
+std::string quoteInput(const std::string& text, size_t maxBytes = 40);
+
+}  // namespace vox

@@ -16,6 +16,7 @@
 #include "obj_reader.h"
 #include "vox/error.h"
 #include "vox/import.h"
+#include "vox/input_file.h"
 
 namespace vox {
 namespace {
@@ -539,18 +540,28 @@ class CourseParser {
     expect("obj_file");
     const Token name = next("a file name");
     expect("}");
-    std::filesystem::path file(std::string(name.text));
-    if (file.is_relative()) file = folder_ / file;
-    const std::string key = file.lexically_normal().string();
+    // Meshes are read only from the scene's own folder (and below), like glTF buffers and OBJ libraries.
+    std::string objPath;
+    try {
+      objPath = resolveInsideFolder(path_, std::string(name.text));
+    } catch (const InputError& e) {
+      failAt(name, "mesh file: ", std::string(e.what()).substr(path_.size() + 2));
+    }
+    const std::string key = objPath;
     auto it = meshes_.find(key);
     if (it == meshes_.end()) {
       std::error_code ec;
-      if (!std::filesystem::is_regular_file(file, ec)) failAt(name, "cannot open mesh file '", file.string(), "'");
-      const std::string objPath = file.string();
+      if (!std::filesystem::is_regular_file(objPath, ec)) failAt(name, "cannot open mesh file '", objPath, "'");
       it = meshes_.emplace(key, parseObj(readTextFile(objPath, "mesh file", kMaxObjFileBytes), objPath)).first;
       for (const std::string& w : it->second.warnings) warn(w);
     }
     const ObjData& mesh = it->second;
+    // Each instance copies the mesh: checked before the copy, so a scene instancing a large mesh thousands of
+    // times is refused with its size instead of growing until memory runs out.
+    const double triangles = double(out.triangles.size() + mesh.triangles.size());
+    if (triangles * sizeof(Triangle) * 2 > double(memoryBudgetBytes()))
+      checkMemory(triangles * sizeof(Triangle) * 2, path_ + ":" + std::to_string(t.line),
+                  "TriangleMesh instancing " + std::to_string(uint64_t(triangles)) + " triangles");
     const uint32_t material = currentMaterial(t);
     std::vector<Vec3> world(mesh.vertices.size());
     for (size_t i = 0; i < world.size(); ++i) world[i] = transformPoint(m, mesh.vertices[i]);

@@ -143,6 +143,22 @@ expect_err "GLB instancing 6e8 triangles" "instanced.glb: instancing 600000000 t
 micros=$((${EPOCHREALTIME/./} - start))
 [ "$micros" -lt 1500000 ] || { echo "FAIL GLB instancing refused after ${micros} us"; fails=$((fails + 1)); }
 
+# --- course scenes: meshes only from the scene's folder; instancing bounded ---
+mkdir -p "$T/course/sub"
+cp "$SRC/scenes/bunny_1k.obj" "$T/bunny_outside.obj"
+cp "$SRC/scenes/bunny_1k.obj" "$T/course/sub/bunny.obj"
+for ref in ../bunny_outside.obj "$T/bunny_outside.obj" sub/../../bunny_outside.obj; do
+  { cat "$T/light.txt"; echo "Group { numObjects 1 MaterialIndex 0 TriangleMesh { obj_file $ref } }"; } >"$T/course/out.txt"
+  run "course mesh $ref" 2 10 "$BIN/vox-voxelize" "$T/course/out.txt" -o "$T/course.vgrid"
+  expect_err "course mesh $ref" "out.txt:5: mesh file: .*\(outside the folder\|absolute paths are refused\)"
+done
+{ cat "$T/light.txt"; echo "Group { numObjects 1 MaterialIndex 0 TriangleMesh { obj_file sub/bunny.obj } }"; } >"$T/course/in.txt"
+run "course mesh in a subfolder" 0 10 "$BIN/vox-voxelize" "$T/course/in.txt" -o "$T/course.vgrid" --quiet
+{ cat "$T/light.txt"; echo "Group { numObjects 3000 MaterialIndex 0"
+  for i in $(seq 3000); do echo "TriangleMesh { obj_file sub/bunny.obj }"; done; echo "}"; } >"$T/course/many.txt"
+VOX_MEMORY_LIMIT_MB=100 run "3,000 TriangleMesh instances over the limit" 2 10 "$BIN/vox-voxelize" "$T/course/many.txt" -o "$T/many.vgrid"
+expect_err "3,000 TriangleMesh instances over the limit" "many.txt:[0-9]*: TriangleMesh instancing [0-9]* triangles needs about"
+
 # --- memory estimates before allocating (the limit is lowered so the test stays small) ---
 export VOX_MEMORY_LIMIT_MB=64
 run "bbox at 1024^3 over the limit" 2 20 "$BIN/vox-voxelize" "$SRC/scenes/bunny_1k.obj" -o "$T/b.vgrid" --res 1024 --method bbox

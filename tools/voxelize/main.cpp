@@ -40,7 +40,8 @@ int run(const Options& opt) {
 
   const Scene scene = loadScene(opt.scene);
   if (!opt.common.quiet)
-    for (const auto& w : scene.warnings) std::fprintf(stderr, "vox-voxelize: warning: %s\n", w.c_str());
+    for (const auto& w : scene.warnings)
+      std::fprintf(stderr, "vox-voxelize: warning: %s\n", quoteInput(w, 600).c_str());  // one line, escaped
   ProgressBar bar("voxelizing", opt.common.quiet);
   vo.progress = [&](double f) {
     bar.update(f);

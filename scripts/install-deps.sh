@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages libvox needs, idempotently: nothing is fetched when all are present.
-# Usage: scripts/install-deps.sh [--bench] [--meshlab]
+# Usage: scripts/install-deps.sh [--bench] [--meshlab] [--fuzz]
 set -euo pipefail
 packages=(build-essential cmake ninja-build pkg-config python3
   libcgal-dev libopenmesh-dev libopenimageio-dev libtinygltf-dev libstb-dev nlohmann-json3-dev
@@ -9,6 +9,7 @@ for arg in "$@"; do
   case $arg in
     --bench) packages+=(libbenchmark-dev libembree-dev libopenvdb-dev) ;;
     --meshlab) packages+=(meshlab xvfb xauth) ;;
+    --fuzz) packages+=(clang libclang-rt-14-dev) ;;  # libFuzzer and the sanitizer runtimes (scripts/fuzz.sh)
     *) echo "install-deps.sh: unknown option $arg" >&2; exit 1 ;;
   esac
 done

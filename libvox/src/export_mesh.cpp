@@ -22,10 +22,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <tiny_gltf.h>
 
 #include "vox/atomic_file.h"
@@ -185,11 +182,14 @@ class QuietOpenMesh {
   bool log_, out_, err_;
 };
 
-void writeWithOpenMesh(const std::string& temp, const std::string& path, const VoxelMesh& mesh, OM::IO::Options opt) {
+// Through a stream rather than a file name: OpenMesh's writers do not check their writes, the stream does.
+void writeWithOpenMesh(OutputFile& out, const std::string& ext, const VoxelMesh& mesh, OM::IO::Options opt) {
   VoxelMeshExporter exporter(mesh);
   QuietOpenMesh quiet;
-  if (!OM::IO::IOManager().write(temp, exporter, opt, 9))
-    fail<OutputError>(path, ": cannot write (OpenMesh writer failed)");
+  if (!OM::IO::IOManager().write(out.stream(), ext, exporter, opt, 9)) {
+    out.flush();  // a write error is the better message
+    fail<OutputError>(out.path(), ": cannot write (OpenMesh writer failed)");
+  }
 }
 
 // Vertices repeated per colour, for formats whose colours live on vertices: corner k of the mesh becomes vertex
@@ -229,14 +229,11 @@ ColorSplit splitByColor(const VoxelMesh& mesh) {
   return split;
 }
 
+// Text built in a string and handed to the OutputFile a megabyte at a time (faster than a std::ostream for many
+// short pieces).
 class BufferedFile {
  public:
-  BufferedFile(const std::string& temp, const std::string& path) : path_(path), file_(std::fopen(temp.c_str(), "wb")) {
-    if (!file_) fail<OutputError>(path, ": cannot write: ", std::strerror(errno));
-  }
-  ~BufferedFile() {
-    if (file_) std::fclose(file_);
-  }
+  explicit BufferedFile(OutputFile& out) : out_(out) {}
   void put(std::string_view s) {
     buffer_.append(s);
     if (buffer_.size() > (1 << 20)) flush();
@@ -251,27 +248,18 @@ class BufferedFile {
     const auto r = std::to_chars(tmp, tmp + sizeof tmp, x);
     buffer_.append(tmp, r.ptr);
   }
-  void close() {
-    flush();
-    const bool bad = std::ferror(file_) != 0;
-    const int rc = std::fclose(file_);
-    file_ = nullptr;
-    if (bad || rc != 0) fail<OutputError>(path_, ": cannot write: ", std::strerror(errno));
+  void flush() {
+    out_.write(buffer_);
+    buffer_.clear();
   }
 
  private:
-  void flush() {
-    if (!buffer_.empty() && std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size())
-      fail<OutputError>(path_, ": cannot write: ", std::strerror(errno));
-    buffer_.clear();
-  }
-  std::string path_;
-  std::FILE* file_;
+  OutputFile& out_;
   std::string buffer_;
 };
 
-void writeObj(const std::string& temp, const std::string& path, const VoxelMesh& mesh) {
-  BufferedFile out(temp, path);
+void writeObj(OutputFile& file, const VoxelMesh& mesh) {
+  BufferedFile out(file);
   out.put("# voxel mesh written by libvox ");
   out.put(versionString());
   out.put("\n# vertex colours as \"v x y z r g b\" (r g b in [0, 1])\n");
@@ -311,7 +299,7 @@ void writeObj(const std::string& temp, const std::string& path, const VoxelMesh&
     }
     faces([&](uint32_t k) { return mesh.faceVertices[k]; });
   }
-  out.close();
+  out.flush();
 }
 
 // glTF COLOR_0 is linear; our face colours are sRGB-encoded display values (IEC 61966-2-1 transfer function).
@@ -320,7 +308,7 @@ float srgbToLinear(uint8_t c) {
   return float(x <= 0.04045 ? x / 12.92 : std::pow((x + 0.055) / 1.055, 2.4));
 }
 
-void writeGltf(const std::string& temp, const std::string& path, const VoxelMesh& polygons, bool binary) {
+void writeGltf(OutputFile& out, const VoxelMesh& polygons, bool binary) {
   const VoxelMesh mesh = polygons.isTriangleMesh() ? polygons : triangulateVoxelMesh(polygons);
   tinygltf::Model model;
   model.asset.version = "2.0";
@@ -411,40 +399,33 @@ void writeGltf(const std::string& temp, const std::string& path, const VoxelMesh
   model.scenes.push_back(scene);
   model.defaultScene = 0;
   tinygltf::TinyGLTF writer;
-  if (!writer.WriteGltfSceneToFile(&model, temp, true, true, !binary, binary))
-    fail<OutputError>(path, ": cannot write (glTF writer failed)");
+  // The stream overload embeds the buffer (a data URI in .gltf, the BIN chunk in .glb), as the file overload did
+  // with embedBuffers, and leaves the writes to the checked stream.
+  if (!writer.WriteGltfSceneToStream(&model, out.stream(), !binary, binary)) {
+    out.flush();  // a write error is the better message
+    fail<OutputError>(out.path(), ": cannot write (glTF writer failed)");
+  }
 }
 
 }  // namespace
 
 void writeVoxelMesh(const std::string& path, const VoxelMesh& mesh, bool binary) {
   const MeshFormat format = meshFormatFromPath(path);
-  writeAtomically(path, [&](const std::string& temp) {
-    switch (format) {
-      case MeshFormat::Ply: {
-        OM::IO::Options opt;
-        if (binary) opt += OM::IO::Options::Binary;
-        if (mesh.hasColors()) opt += OM::IO::Options::FaceColor;
-        writeWithOpenMesh(temp, path, mesh, opt);
-        break;
-      }
-      case MeshFormat::Off: {
-        OM::IO::Options opt;
-        if (mesh.hasColors()) opt += OM::IO::Options::FaceColor;
-        writeWithOpenMesh(temp, path, mesh, opt);
-        break;
-      }
-      case MeshFormat::Stl: {
-        OM::IO::Options opt;
-        if (binary) opt += OM::IO::Options::Binary;
-        writeWithOpenMesh(temp, path, mesh.isTriangleMesh() ? mesh : triangulateVoxelMesh(mesh), opt);
-        break;
-      }
-      case MeshFormat::Obj: writeObj(temp, path, mesh); break;
-      case MeshFormat::Glb: writeGltf(temp, path, mesh, true); break;
-      case MeshFormat::Gltf: writeGltf(temp, path, mesh, false); break;
-    }
-  });
+  OutputFile out(path);
+  OM::IO::Options opt;
+  if (binary && (format == MeshFormat::Ply || format == MeshFormat::Stl)) opt += OM::IO::Options::Binary;
+  if (mesh.hasColors() && (format == MeshFormat::Ply || format == MeshFormat::Off)) opt += OM::IO::Options::FaceColor;
+  switch (format) {
+    case MeshFormat::Ply: writeWithOpenMesh(out, ".ply", mesh, opt); break;
+    case MeshFormat::Off: writeWithOpenMesh(out, ".off", mesh, opt); break;
+    case MeshFormat::Stl:
+      writeWithOpenMesh(out, ".stl", mesh.isTriangleMesh() ? mesh : triangulateVoxelMesh(mesh), opt);
+      break;
+    case MeshFormat::Obj: writeObj(out, mesh); break;
+    case MeshFormat::Glb: writeGltf(out, mesh, true); break;
+    case MeshFormat::Gltf: writeGltf(out, mesh, false); break;
+  }
+  out.commit();
 }
 
 }  // namespace vox

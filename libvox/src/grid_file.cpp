@@ -357,13 +357,7 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
 
 void writeGridFile(const std::string& path, const Scene& scene, const Grid& grid) {
   const std::string bytes = encodeGridFile(scene, grid);
-  writeAtomically(path, [&](const std::string& temp) {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (!out) fail<OutputError>(path, ": cannot create file");
-    out.write(bytes.data(), std::streamsize(bytes.size()));
-    out.flush();
-    if (!out) fail<OutputError>(path, ": write failed (disk full?)");
-  });
+  writeFileAtomically(path, bytes);
 }
 
 GridFile readGridFile(const std::string& path) {

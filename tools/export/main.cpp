@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "../common/cli.h"
+#include "vox/atomic_file.h"
 #include "vox/error.h"
 #include "vox/grid_file.h"
 #include "vox/progress.h"
@@ -36,11 +37,7 @@ int run(const Options& opt) {
   } catch (const InputError& e) {
     throw UsageError(e.what());
   }
-  const std::filesystem::path parent = std::filesystem::path(opt.output).parent_path();
-  const std::string folder = parent.empty() ? "." : parent.string();
-  std::error_code ec;
-  if (!std::filesystem::is_directory(folder, ec)) fail<OutputError>(opt.output, ": folder does not exist");
-  if (::access(folder.c_str(), W_OK) != 0) fail<OutputError>(opt.output, ": folder is not writable");
+  checkOutputPath(opt.output, {opt.grid});
   const FaceMode faces = parseFaceMode(opt.faces);
   const ColorMode color = parseColorMode(opt.color);
 

@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "../common/cli.h"
+#include "vox/atomic_file.h"
 #include "vox/accel.h"
 #include "vox/error.h"
 #include "vox/grid_file.h"
@@ -74,10 +75,7 @@ int run(const Options& opt) {
   if (opt.fov != 0 && !(opt.fov > 0 && opt.fov < 180)) fail<UsageError>("--fov must be between 0 and 180 degrees");
   if (!imageFormatSupported(opt.output))
     fail<UsageError>(opt.output, ": unknown image format (use an extension such as .png, .tga, .exr, .jpg)");
-  const std::filesystem::path parent = std::filesystem::path(opt.output).parent_path();
-  std::error_code ec;
-  if (!parent.empty() && !std::filesystem::is_directory(parent, ec))
-    fail<OutputError>(opt.output, ": folder does not exist");
+  checkOutputPath(opt.output, {opt.grid});
   ro.samples = opt.samples;
 
   const GridFile file = readGridFile(opt.grid);

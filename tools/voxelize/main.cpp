@@ -5,6 +5,7 @@
 #include <chrono>
 
 #include "../common/cli.h"
+#include "vox/atomic_file.h"
 #include "vox/error.h"
 #include "vox/fill.h"
 #include "vox/grid_file.h"
@@ -38,6 +39,8 @@ int run(const Options& opt) {
   if (!opt.bounds.empty()) vo.bounds = Box{{opt.bounds[0], opt.bounds[1], opt.bounds[2]}, {opt.bounds[3], opt.bounds[4], opt.bounds[5]}};
   vo.memoryLimitBytes = memoryBudgetBytes();
 
+  // Before the scene is read: `-o scene.glb` would destroy the scene.
+  checkOutputPath(opt.output, {opt.scene});
   const Scene scene = loadScene(opt.scene);
   if (!opt.common.quiet)
     for (const auto& w : scene.warnings)

@@ -1,14 +1,66 @@
-// Writing an output through a temporary file and a rename, so that readers never see a half-written file.
+// Writing an output so that a failure (full disk, signal, error) never leaves a half-written file nor loses the old
+// one: bytes go to a hidden temporary file in the output's folder, which is flushed to disk and renamed over the
+// output. A character device or FIFO named as output is written straight into instead (a rename would replace the
+// node with a regular file); any other file that is not a regular file is refused.
 #pragma once
 
 #include <functional>
+#include <memory>
+#include <ostream>
 #include <string>
+#include <string_view>
+#include <vector>
 
 namespace vox {
 
-// Calls write(tempPath) to produce the file, then renames tempPath to `path`. On any exception the temporary
-// file is removed and the exception propagates. Throws OutputError when the folder is not writable or the
-// rename fails.
+// One output being written. The constructor opens the temporary file (`.NAME.tmpPID_N.EXT` beside `path`) or the
+// device; write() and stream() add bytes; commit() makes them the output. Destroying an uncommitted OutputFile
+// removes the temporary file, so an exception anywhere leaves the old output as it was. While the temporary file
+// exists its name sits in a registry that a SIGINT/SIGTERM handler (installed on first use, unless the signal is
+// ignored) unlinks before it ends the process with _exit(128 + signal).
+// @throw OutputError "PATH: cannot write: REASON" from every member when the output cannot be written.
+class OutputFile {
+ public:
+  explicit OutputFile(const std::string& path);
+  ~OutputFile();
+  OutputFile(const OutputFile&) = delete;
+  OutputFile& operator=(const OutputFile&) = delete;
+
+  // Appends bytes, checking every write().
+  void write(std::string_view bytes);
+  // A buffered stream into the same file, for writers that take a std::ostream. A failed write does not throw from
+  // inside the writer (writers are not exception-safe); it is recorded and reported by commit().
+  std::ostream& stream();
+  // Writes out what stream() holds; throws the first write error the stream met.
+  void flush();
+  // Flushes the stream, fsyncs and closes the file, renames it over the output and fsyncs the folder.
+  void commit();
+
+  const std::string& path() const { return path_; }
+  // Whether bytes go straight into a character device or FIFO (no temporary file, no rename).
+  bool isDevice() const;
+
+ private:
+  struct Impl;
+  std::string path_;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Writes `bytes` to `path` through an OutputFile (see above).
+// @throw OutputError when the output cannot be written; the old output is then untouched.
+void writeFileAtomically(const std::string& path, std::string_view bytes);
+
+// Calls write(tempPath) to produce the file with a writer that only takes a path, then flushes it to disk and
+// renames it over `path`. On any exception the temporary file is removed and the exception propagates. Prefer
+// OutputFile: writers given a path rarely check their writes.
+// @throw OutputError when the folder is not writable, the output is not a regular file, or flush or rename fail.
 void writeAtomically(const std::string& path, const std::function<void(const std::string& tempPath)>& write);
+
+// Checks an output path before any input is read, so a bad output costs nothing:
+//  - UsageError when `output` is the same file as one of `inputs` (std::filesystem::equivalent: also through
+//    symlinks and hard links), since writing it would destroy the input;
+//  - OutputError when its folder does not exist or it exists but is neither a regular file, a character device
+//    nor a FIFO.
+void checkOutputPath(const std::string& output, const std::vector<std::string>& inputs);
 
 }  // namespace vox

@@ -17,42 +17,32 @@
 #include "obj_reader.h"
 #include "vox/error.h"
 #include "vox/import.h"
+#include "vox/input_file.h"
 
 namespace vox {
 namespace {
 
 namespace fs = std::filesystem;
 
-// Whether `p` (canonical) lies inside the folder `folder` (canonical).
-bool isInside(const fs::path& p, const fs::path& folder) {
-  const fs::path rel = p.lexically_relative(folder);
-  return !rel.empty() && *rel.begin() != ".." && *rel.begin() != ".";
-}
-
 // The library file `lib` names, or nullopt (with a warning) when it does not exist.
 std::optional<fs::path> resolveLibrary(const std::string& objPath, const ObjLibrary& lib, Scene& scene) {
-  const fs::path written(lib.name);
-  const fs::path normal = written.lexically_normal();
-  if (written.is_absolute() || (!normal.empty() && *normal.begin() == ".."))
-    fail<InputError>(objPath, ":", lib.line, ": material library ", quotedWord(lib.name),
-                     " is outside the OBJ file's folder");
-  fs::path folder = fs::path(objPath).parent_path();
-  if (folder.empty()) folder = ".";
-  const fs::path file = folder / written;
+  const std::string where = objPath + ":" + std::to_string(lib.line) + ": material library";
+  std::string file;
+  try {
+    file = resolveInsideFolder(objPath, lib.name);  // the one containment check (input_file.h)
+  } catch (const InputError& e) {
+    std::string detail = e.what();  // "OBJPATH: 'NAME': why", said here with the line
+    if (detail.rfind(objPath + ": ", 0) == 0) detail.erase(0, objPath.size() + 2);
+    fail<InputError>(where, ": ", detail);
+  }
   std::error_code ec;
   if (!fs::exists(file, ec)) {
-    scene.warnings.push_back(objPath + ":" + std::to_string(lib.line) + ": material library " + quotedWord(lib.name) +
+    scene.warnings.push_back(where + " " + quotedWord(lib.name) +
                              " not found; its materials are drawn in default white");
     return std::nullopt;
   }
-  const fs::path canonicalFile = fs::canonical(file, ec);
-  const fs::path canonicalFolder = fs::canonical(folder, ec);
-  if (ec || !isInside(canonicalFile, canonicalFolder))
-    fail<InputError>(objPath, ":", lib.line, ": material library ", quotedWord(lib.name),
-                     " is outside the OBJ file's folder");
-  if (!fs::is_regular_file(canonicalFile, ec))
-    fail<InputError>(objPath, ":", lib.line, ": material library ", quotedWord(lib.name), " is not a regular file");
-  return canonicalFile;
+  if (!fs::is_regular_file(file, ec)) fail<InputError>(where, " ", quotedWord(lib.name), " is not a regular file");
+  return fs::path(file);
 }
 
 // Reads every library once, appending its materials to scene.materials; returns each name's last definition.

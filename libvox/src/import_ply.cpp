@@ -94,7 +94,7 @@ struct PlyHeader {
   std::string format;
   std::vector<PlyElement> elements;
   size_t bodyStart = 0;  // byte offset of the first byte after end_header's line
-  int lines = 0;         // header lines, so that the body's first line is lines + 1
+  long long lines = 0;       // header lines, so that the body's first line is lines + 1
 };
 
 // Reads one header line's property into `e`; false when malformed.
@@ -124,7 +124,7 @@ PlyHeader parseHeader(const std::string& data, const std::string& path) {
     if (eol == std::string::npos) fail<InputError>(path, ": PLY header has no end_header line");
     std::string line = data.substr(pos, eol - pos);
     pos = eol + 1;
-    const int lineNumber = ++h.lines;
+    const long long lineNumber = ++h.lines;
     if (!line.empty() && line.back() == '\r') line.pop_back();
     std::istringstream words(line);
     std::vector<std::string> w;
@@ -263,19 +263,20 @@ class AsciiCursor {
     if (!s.empty() && s[0] == '+') s.remove_prefix(1);
     long long v = 0;
     const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (s.empty() || s[0] == '+' || end != s.data() + s.size() || (ec != std::errc() && ec != std::errc::result_out_of_range))
+    const bool tooLarge = ec == std::errc::result_out_of_range;
+    if (s.empty() || s[0] == '+' || end != s.data() + s.size() || (ec != std::errc() && !tooLarge))
       failHere("bad ", typeName(t), " value ", quotedWord(token));
     long long lo = 0, hi = 0;
     integerRange(t, lo, hi);
-    if (ec == std::errc::result_out_of_range || v < lo || v > hi)
+    if (tooLarge || v < lo || v > hi)
       failHere("value ", token, " does not fit in a ", typeName(t), " property");
     return v;
   }
 
   const std::string& data_;
   size_t pos_;
-  int line_;
-  int tokenLine_ = 0;
+  long long line_;
+  long long tokenLine_ = 0;
   const std::string& path_;
   const PlyElement* element_ = nullptr;
   long long index_ = 0;
@@ -315,7 +316,8 @@ class BinaryCursor {
  private:
   uint64_t raw(PlyType t) {
     const size_t n = typeSize(t);
-    if (size_ - pos_ < n) fail<InputError>(path_, ": PLY file ends inside ", element_->name, " ", index_, " (truncated?)");
+    if (size_ - pos_ < n)
+      fail<InputError>(path_, ": PLY file ends inside ", element_->name, " ", index_, " (truncated?)");
     uint64_t u = 0;
     for (size_t i = 0; i < n; ++i) u |= static_cast<uint64_t>(bytes_[pos_ + (bigEndian_ ? n - 1 - i : i)]) << (8 * i);
     pos_ += n;
@@ -415,7 +417,8 @@ Scene importPly(const std::string& path) {
   for (const auto& f : mesh.triangles)
     scene.triangles.push_back({{mesh.vertices[f[0]], mesh.vertices[f[1]], mesh.vertices[f[2]]}, 0});
   if (mesh.shortFaces > 0)
-    scene.warnings.push_back(path + ": " + std::to_string(mesh.shortFaces) + " faces with fewer than 3 vertices skipped");
+    scene.warnings.push_back(path + ": " + std::to_string(mesh.shortFaces) +
+                             " faces with fewer than 3 vertices skipped");
   return scene;
 }
 

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "vox/error.h"
+#include "vox/input_file.h"
 
 namespace vox {
 namespace {
@@ -23,7 +24,7 @@ class LineReader {
   explicit LineReader(std::string_view text) : text_(text) {}
 
   // The next logical line and the number of its first physical line; false at the end of the text.
-  bool next(std::string_view& line, int& number) {
+  bool next(std::string_view& line, long long& number) {
     if (pos_ >= text_.size()) return false;
     number = physical_ + 1;
     joined_.clear();
@@ -53,7 +54,7 @@ class LineReader {
  private:
   std::string_view text_;
   size_t pos_ = 0;
-  int physical_ = 0;
+  long long physical_ = 0;
   std::string joined_;  // a line built from continuations
 };
 
@@ -110,7 +111,7 @@ class ObjParser {
 
   ObjData run() {
     std::string_view line;
-    int number = 0;
+    long long number = 0;
     while (lines_.next(line, number)) statement(Words{line}, number);
     checkForwardIndices();
     if (unknownCount_ > 0)
@@ -122,11 +123,11 @@ class ObjParser {
 
  private:
   template <typename... Parts>
-  [[noreturn]] void failAt(int line, const Parts&... parts) const {
+  [[noreturn]] void failAt(long long line, const Parts&... parts) const {
     fail<InputError>(path_, ":", line, ": ", parts...);
   }
 
-  void statement(Words words, int line) {
+  void statement(Words words, long long line) {
     const std::string_view keyword = words.next();
     if (keyword.empty()) return;
     if (keyword == "v") {
@@ -147,7 +148,7 @@ class ObjParser {
     }
   }
 
-  void vertex(Words& words, int line) {
+  void vertex(Words& words, long long line) {
     double xyz[3];
     for (double& c : xyz) {
       const std::string_view w = words.next();
@@ -163,7 +164,7 @@ class ObjParser {
   }
 
   // The 0-based vertex index of one face corner `a`, `a/t`, `a//n` or `a/t/n`.
-  uint32_t faceIndex(std::string_view word, int line) {
+  uint32_t faceIndex(std::string_view word, long long line) {
     const size_t slash = word.find('/');
     const std::string_view head = word.substr(0, slash);
     if (slash != std::string_view::npos) {
@@ -183,7 +184,8 @@ class ObjParser {
     const IntegerStatus status = parseInteger(head, i);
     const long long seen = static_cast<long long>(data_.vertices.size());
     if (status == IntegerStatus::Bad) failAt(line, "bad face index ", quotedWord(word));
-    if (status == IntegerStatus::TooLarge) failAt(line, "face index ", quotedWord(head), " out of range (", seen, " vertices)");
+    if (status == IntegerStatus::TooLarge)
+      failAt(line, "face index ", quotedWord(head), " out of range (", seen, " vertices)");
     const long long zeroBased = i > 0 ? i - 1 : seen + i;
     // No file within kMaxObjFileBytes holds 2^32 - 1 vertices, so such an index can never be valid.
     if (i == 0 || zeroBased < 0 || zeroBased >= static_cast<long long>(UINT32_MAX))
@@ -192,7 +194,7 @@ class ObjParser {
     return static_cast<uint32_t>(zeroBased);
   }
 
-  void face(Words& words, int line) {
+  void face(Words& words, long long line) {
     polygon_.clear();
     for (std::string_view w = words.next(); !w.empty(); w = words.next()) polygon_.push_back(faceIndex(w, line));
     if (polygon_.size() < 3) failAt(line, "face needs at least 3 vertices");
@@ -202,7 +204,7 @@ class ObjParser {
     }
   }
 
-  void useMaterial(std::string_view name, int line) {
+  void useMaterial(std::string_view name, long long line) {
     if (name.empty()) failAt(line, "usemtl needs a material name");
     const auto [it, added] =
         materialIds_.try_emplace(std::string(name), static_cast<uint32_t>(data_.materialNames.size()));
@@ -222,7 +224,7 @@ class ObjParser {
 
   struct ForwardIndex {
     uint32_t zeroBased;
-    int line;
+    long long line;
     long long written;
   };
 
@@ -235,11 +237,11 @@ class ObjParser {
   uint32_t currentMaterial_ = kNoObjMaterial;
   size_t unknownCount_ = 0;
   std::string firstUnknown_;
-  int firstUnknownLine_ = 0;
+  long long firstUnknownLine_ = 0;
 };
 
 // `Kd`/`Ks`: one number (grey) or three; each finite and not negative.
-Vec3 readColour(Words& words, std::string_view keyword, const std::string& path, int line) {
+Vec3 readColour(Words& words, std::string_view keyword, const std::string& path, long long line) {
   double c[3];
   int n = 0;
   for (std::string_view w = words.next(); !w.empty(); w = words.next()) {
@@ -254,7 +256,7 @@ Vec3 readColour(Words& words, std::string_view keyword, const std::string& path,
   return {c[0], c[1], c[2]};
 }
 
-double readScalar(Words& words, std::string_view keyword, const std::string& path, int line) {
+double readScalar(Words& words, std::string_view keyword, const std::string& path, long long line) {
   const std::string_view w = words.next();
   double v = 0;
   if (w.empty()) fail<InputError>(path, ":", line, ": ", keyword, " needs a number");
@@ -265,21 +267,10 @@ double readScalar(Words& words, std::string_view keyword, const std::string& pat
 }  // namespace
 
 std::string quotedWord(std::string_view word) {
-  constexpr size_t kMaxShown = 40;
-  std::string out = "'";
-  for (size_t i = 0; i < word.size() && i < kMaxShown; ++i) {
-    const auto c = static_cast<unsigned char>(word[i]);
-    if (c >= 0x20 && c < 0x7f) {
-      out += static_cast<char>(c);
-    } else {
-      static const char* kHex = "0123456789abcdef";
-      out += "\\x";
-      out += kHex[c >> 4];
-      out += kHex[c & 15];
-    }
-  }
-  if (word.size() > kMaxShown) out += "...";
-  return out + "'";
+  std::string out(1, '\'');
+  out += quoteInput(std::string(word));
+  out += '\'';
+  return out;
 }
 
 std::string readTextFile(const std::string& path, const char* what, size_t maxBytes) {
@@ -303,7 +294,7 @@ std::vector<Material> parseMtl(std::string_view text, const std::string& path, s
   std::vector<Material> out;
   LineReader lines(text);
   std::string_view line;
-  int number = 0;
+  long long number = 0;
   Material unnamed;  // takes values given before any newmtl, which no face can use
   while (lines.next(line, number)) {
     Words words{line};

@@ -33,7 +33,7 @@ constexpr uint32_t kNoObjMaterial = UINT32_MAX;
 
 struct ObjLibrary {
   std::string name;  // as written after `mtllib`
-  int line = 0;
+  long long line = 0;
 };
 
 // One OBJ file's geometry. triangles[i] holds 0-based indices into `vertices`, all in range;
@@ -43,7 +43,7 @@ struct ObjData {
   std::vector<std::array<uint32_t, 3>> triangles;
   std::vector<uint32_t> triangleMaterial;
   std::vector<std::string> materialNames;  // `usemtl` names, in order of first use
-  std::vector<int> materialLines;          // the line of each name's first `usemtl`
+  std::vector<long long> materialLines;        // the line of each name's first `usemtl`
   std::vector<ObjLibrary> libraries;       // every `mtllib` file name, in file order
   std::vector<std::string> warnings;
 };

@@ -58,7 +58,8 @@ void validateMaterial(const Material& m, size_t i, const std::string& source) {
   colour(m.reflective, "reflective colour");
   colour(m.transparent, "transparent colour");
   if (!std::isfinite(m.exponent) || !(m.exponent >= 0))
-    fail<InputError>(source, ": material ", i, " '", m.name, "': exponent ", m.exponent, " is not a finite number >= 0");
+    fail<InputError>(source, ": material ", i, " '", m.name, "': exponent ", m.exponent,
+                     " is not a finite number >= 0");
   if (!std::isfinite(m.indexOfRefraction) || !(m.indexOfRefraction > 0))
     fail<InputError>(source, ": material ", i, " '", m.name, "': index of refraction ", m.indexOfRefraction,
                      " is not a finite positive number");

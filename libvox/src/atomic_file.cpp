@@ -206,13 +206,16 @@ OutputFile::OutputFile(const std::string& path) : path_(path), impl_(std::make_u
     fail<OutputError>(path, ": cannot write: not a regular file, character device or FIFO");
   std::error_code ec;
   if (!std::filesystem::is_directory(folderOf(path), ec)) fail<OutputError>(path, ": folder does not exist");
-  impl_->temp = temporaryName(path);
-  impl_->slot = publishTemporary(impl_->temp);
-  impl_->fd = ::open(impl_->temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-  if (impl_->fd < 0) {
+  // O_EXCL: never write through a name someone else placed; a leftover of a crashed process that had our pid
+  // only costs another name.
+  for (int attempt = 0; impl_->fd < 0; ++attempt) {
+    impl_->temp = temporaryName(path);
+    impl_->slot = publishTemporary(impl_->temp);
+    impl_->fd = ::open(impl_->temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (impl_->fd >= 0) break;
     const int err = errno;
     unpublishTemporary(impl_->slot);
-    failWrite(path, err);
+    if (err != EEXIST || attempt == 100) failWrite(path, err);
   }
   // The new file keeps the permission bits of the one it replaces (as an in-place write would).
   if (exists) ::fchmod(impl_->fd, st.st_mode & 0777);

@@ -57,7 +57,9 @@ bool writePixels(OIIO::ImageOutput& out, const std::string& name, const std::str
     return false;
   }
   const uint64_t count = uint64_t(image.width) * image.height;
-  auto channel = [&](uint64_t i, uint32_t c) { return image.pixels[i * image.channels + std::min(c, image.channels - 1)]; };
+  auto channel = [&](uint64_t i, uint32_t c) {
+    return image.pixels[i * image.channels + std::min(c, image.channels - 1)];
+  };
   bool ok;
   if (asFloat) {
     std::vector<float> data(count * channels);

@@ -45,7 +45,7 @@ expect_code 0 "voxelize large" "$V" "$src/scenes/teapot.obj" -o "$tmp/large.vgri
 
 # The output kinds: NAME|COMMAND-FOR-THE-SMALL-OUTPUT|COMMAND-FOR-THE-LARGE-OUTPUT, OUT standing for the output path.
 kinds=(
-  "grid.vgrid|$V $src/scenes/scene5_01_sphere.txt -o OUT --grid 3 3 3 -q|$V $src/scenes/teapot.obj -o OUT --res 96 -q"
+  "grid.vgrid|$V $src/scenes/scene5_01_sphere.txt -o OUT --grid 3 3 3 -q|$V $src/scenes/teapot.obj -o OUT --res 96"
 )
 for ext in ply obj off stl glb gltf; do
   kinds+=("mesh.$ext|$E $tmp/small.vgrid -o OUT -q|$E $tmp/large.vgrid -o OUT --faces all -q")
@@ -54,7 +54,8 @@ kinds+=("ascii.ply|$E $tmp/small.vgrid -o OUT --ascii -q|$E $tmp/large.vgrid -o 
 for ext in png tga bmp jpg exr; do
   mode=normals
   [ "$ext" = png ] && mode=count  # compresses less
-  kinds+=("image.$ext|$T $tmp/small.vgrid -o OUT --size 4 4 -q|$T $tmp/large.vgrid -o OUT --size 1024 1024 --mode $mode -q")
+  small="$T $tmp/small.vgrid -o OUT --size 4 4 -q"
+  kinds+=("image.$ext|$small|$T $tmp/large.vgrid -o OUT --size 1024 1024 --mode $mode -q")
 done
 
 # full_disk_case LABEL DIR NAME SMALL LARGE [WRAPPER...]: the old output made by SMALL in DIR, then LARGE must fail
@@ -67,7 +68,7 @@ full_disk_case() {
   [ -s "$out" ] || { fail "$label $name: old output missing"; return; }
   cp "$out" "$tmp/reference"
   expect_code 3 "$label $name" "$@" ${large//OUT/$out}
-  grep -q "cannot write" "$tmp/err" || fail "$label $name: message does not say 'cannot write': $(head -c 200 "$tmp/err")"
+  grep -q "cannot write" "$tmp/err" || fail "$label $name: message lacks 'cannot write': $(head -c 200 "$tmp/err")"
   cmp -s "$out" "$tmp/reference" || fail "$label $name: old output changed"
   expect_clean "$dir" "$label $name"
 }
@@ -181,9 +182,10 @@ ln "$tmp/grid.ply" "$tmp/grid_hard.ply"
 ln -s grid.png "$tmp/grid_link.png"
 cp "$tmp/scene.obj" "$tmp/scene.ref"
 cp "$tmp/small.vgrid" "$tmp/grid.ref"
-for case in "voxelize|$V $tmp/scene.obj -o $tmp/scene.obj -q" "voxelize via symlink|$V $tmp/scene.obj -o $tmp/scene_link.obj -q" \
-            "export|$E $tmp/grid.ply -o $tmp/grid.ply -q" "export via hard link|$E $tmp/grid.ply -o $tmp/grid_hard.ply -q" \
-            "trace|$T $tmp/grid.png -o $tmp/grid.png -q" "trace via symlink|$T $tmp/grid_link.png -o $tmp/grid.png -q"; do
+for case in "voxelize|$V $tmp/scene.obj -o $tmp/scene.obj" \
+            "voxelize via symlink|$V $tmp/scene.obj -o $tmp/scene_link.obj" \
+            "export|$E $tmp/grid.ply -o $tmp/grid.ply" "export via hard link|$E $tmp/grid.ply -o $tmp/grid_hard.ply" \
+            "trace|$T $tmp/grid.png -o $tmp/grid.png" "trace via symlink|$T $tmp/grid_link.png -o $tmp/grid.png"; do
   IFS='|' read -r what cmd <<<"$case"
   expect_code 1 "output is input: $what" $cmd
   grep -q "same file as the input" "$tmp/err" || fail "output is input: $what: message: $(head -c 200 "$tmp/err")"

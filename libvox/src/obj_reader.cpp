@@ -5,7 +5,6 @@
 #include <charconv>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <string>
 #include <unordered_map>
 #include <utility>
@@ -274,17 +273,15 @@ std::string quotedWord(std::string_view word) {
 }
 
 std::string readTextFile(const std::string& path, const char* what, size_t maxBytes) {
+  requireRegularFile(path, what);
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) fail<InputError>(path, ": cannot open ", what);
-  const auto size = std::filesystem::file_size(path, ec);
-  if (ec) fail<InputError>(path, ": cannot open ", what);
-  if (size > maxBytes)
-    fail<InputError>(path, ": ", what, " is ", size, " bytes, more than the limit of ", maxBytes, " bytes");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail<InputError>(path, ": cannot open ", what);
-  std::string text(static_cast<size_t>(size), '\0');
-  in.read(text.data(), static_cast<std::streamsize>(size));
-  if (static_cast<uintmax_t>(in.gcount()) != size) fail<InputError>(path, ": read error (file changed while read?)");
+  const uintmax_t size = std::filesystem::file_size(path, ec);
+  auto tooLarge = [&](uintmax_t bytes) {
+    fail<InputError>(path, ": ", what, " is ", bytes, " bytes, more than the limit of ", maxBytes, " bytes");
+  };
+  if (!ec && size > maxBytes) tooLarge(size);
+  std::string text = readInputFile(path, what);  // regular files only, within the memory budget
+  if (text.size() > maxBytes) tooLarge(text.size());
   return text;
 }
 

@@ -51,8 +51,8 @@ struct ObjData {
 // `word` quoted for a one-line message: at most 40 characters ("..." after), non-printing bytes as \xHH.
 std::string quotedWord(std::string_view word);
 
-// Reads a whole file into memory. Throws InputError "path: cannot open <what>" when it is not a readable regular
-// file, or names the size when it is larger than `maxBytes`.
+// Reads a whole file into memory through readInputFile (input_file.h: regular files only, within the memory
+// budget). Throws InputError naming `path` when it cannot be read or is larger than `maxBytes`.
 std::string readTextFile(const std::string& path, const char* what, size_t maxBytes);
 
 // Parses OBJ text; `path` only names the file in messages. Throws InputError "path:line: ...".

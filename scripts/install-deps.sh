@@ -4,7 +4,7 @@
 set -euo pipefail
 packages=(build-essential cmake ninja-build pkg-config python3
   libcgal-dev libopenmesh-dev libopenimageio-dev libtinygltf-dev libstb-dev nlohmann-json3-dev
-  libtinyobjloader-dev libtbb-dev libcli11-dev libgtest-dev)
+  libtbb-dev libcli11-dev libgtest-dev)
 for arg in "$@"; do
   case $arg in
     --bench) packages+=(libbenchmark-dev libembree-dev libopenvdb-dev) ;;

@@ -329,7 +329,7 @@ TEST(ObjImport, MaterialLibrariesStayInTheObjFolder) {
 TEST(ObjImport, OversizedAndNonRegularFilesAreRefused) {
   ScratchDir dir("objr");
   fs::create_directories(dir.path() / "d.obj");
-  EXPECT_EQ(inputError([&] { importObj(dir.file("d.obj")); }), dir.file("d.obj") + ": is a folder, not a OBJ file");
+  EXPECT_EQ(inputError([&] { importObj(dir.file("d.obj")); }), dir.file("d.obj") + ": is a folder, expected the OBJ file");
   const std::string none = inputError([&] { importObj(dir.file("none.obj")); });
   EXPECT_EQ(none.rfind(dir.file("none.obj") + ": cannot open OBJ file", 0), 0u) << none;
   const std::string path = write(dir, "a.obj", "v 0 0 0\n");

@@ -83,6 +83,8 @@ Scene importObj(const std::string& path) {
   }
 
   bool usesDefault = false;
+  checkMemory(double(obj.triangles.size()) * sizeof(Triangle), path,
+              "making " + std::to_string(obj.triangles.size()) + " triangles");
   scene.triangles.reserve(obj.triangles.size());
   for (size_t i = 0; i < obj.triangles.size(); ++i) {
     const auto& f = obj.triangles[i];

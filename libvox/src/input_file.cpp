@@ -35,8 +35,8 @@ void checkMemory(double bytes, const std::string& where, const std::string& what
 void requireRegularFile(const std::string& path, const char* what) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) fail<InputError>(path, ": cannot open ", what, ": ", std::strerror(errno));
-  if (S_ISDIR(st.st_mode)) fail<InputError>(path, ": is a folder, not a ", what);
-  if (!S_ISREG(st.st_mode)) fail<InputError>(path, ": not a regular file (a device, FIFO or socket), not a ", what);
+  if (S_ISDIR(st.st_mode)) fail<InputError>(path, ": is a folder, expected the ", what);
+  if (!S_ISREG(st.st_mode)) fail<InputError>(path, ": not a regular file (a device, FIFO or socket), expected the ", what);
 }
 
 std::string readInputFile(const std::string& path, const char* what) {

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages libvox needs, idempotently: nothing is fetched when all are present.
-# Usage: scripts/install-deps.sh [--bench] [--meshlab] [--fuzz]
+# Usage: scripts/install-deps.sh [--bench] [--meshlab] [--clients] [--fuzz]
 set -euo pipefail
 packages=(build-essential cmake ninja-build pkg-config python3
   libcgal-dev libopenmesh-dev libopenimageio-dev libtinygltf-dev libstb-dev nlohmann-json3-dev
@@ -9,6 +9,8 @@ for arg in "$@"; do
   case $arg in
     --bench) packages+=(libbenchmark-dev libembree-dev libopenvdb-dev) ;;
     --meshlab) packages+=(meshlab xvfb xauth) ;;
+    # Real clients of exported meshes (tests/cli/export_*.sh); numpy for Blender's glTF importer.
+    --clients) packages+=(meshlab xvfb xauth assimp-utils blender python3-numpy) ;;
     --fuzz) packages+=(clang libclang-rt-14-dev) ;;  # libFuzzer and the sanitizer runtimes (scripts/fuzz.sh)
     *) echo "install-deps.sh: unknown option $arg" >&2; exit 1 ;;
   esac

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstring>
 #include <iterator>
+#include <map>
 #include <sstream>
 #include <cmath>
 #include <filesystem>
@@ -84,9 +85,18 @@ TEST_F(ExportTest, PlyBinaryAndAsciiReloadWithCountsAndFaceColours) {
       writeVoxelMesh(file, mesh, binary);
       PolyMesh m;
       m.request_face_colors();
-      OpenMesh::IO::Options opt = OpenMesh::IO::Options::FaceColor;
+      m.request_vertex_colors();
+      OpenMesh::IO::Options opt = OpenMesh::IO::Options::FaceColor | OpenMesh::IO::Options::VertexColor;
       ASSERT_TRUE(OpenMesh::IO::read_mesh(m, file, opt));
       EXPECT_TRUE(opt.face_has_color());
+      // Vertex colours too, for Blender's and assimp's PLY importers (issue 10): the dominant colour per vertex.
+      EXPECT_TRUE(opt.vertex_has_color());
+      const std::vector<Rgb8> vertexColors = dominantVertexColors(mesh);
+      ASSERT_EQ(m.n_vertices(), vertexColors.size());
+      for (size_t v = 0; v < vertexColors.size(); v += 5) {
+        const auto c = m.color(PolyMesh::VertexHandle(int(v)));
+        EXPECT_EQ((Rgb8{c[0], c[1], c[2]}), vertexColors[v]) << v;
+      }
       if (mode == FaceMode::All) {
         EXPECT_EQ(m.n_vertices(), 8 * grid_.cellKeys.size());
         EXPECT_EQ(m.n_faces(), 12 * grid_.cellKeys.size());
@@ -106,44 +116,127 @@ TEST_F(ExportTest, PlyBinaryAndAsciiReloadWithCountsAndFaceColours) {
   }
 }
 
-TEST_F(ExportTest, OffReloadsClosed) {
+TEST_F(ExportTest, OffHeaderMatchesItsFaceColoursAndReloadsClosed) {
   const VoxelMesh mesh = buildVoxelMesh(grid_, scene_, FaceMode::Merged, ColorMode::Count);
   writeVoxelMesh(path("mesh.off"), mesh);
+  // "OFF", not "COFF": the colours are per face, after each face's indices (issue 10: assimp refused COFF).
+  std::ifstream in(path("mesh.off"));
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header, "OFF");
+  size_t nv = 0, nf = 0, ne = 1;
+  in >> nv >> nf >> ne;
+  EXPECT_EQ(nv, mesh.vertexCount());
+  EXPECT_EQ(nf, mesh.faceCount());
+  EXPECT_EQ(ne, 0u);
+  std::string line;
+  std::getline(in, line);
+  for (size_t v = 0; v < nv; ++v) {
+    double x, y, z;
+    ASSERT_TRUE(bool(in >> x >> y >> z));
+    EXPECT_EQ(x, mesh.positions[v].x);  // shortest round-trip decimal: exact
+    EXPECT_EQ(z, mesh.positions[v].z);
+  }
+  for (size_t f = 0; f < nf; ++f) {
+    size_t n;
+    ASSERT_TRUE(bool(in >> n));
+    ASSERT_EQ(n, mesh.faceSize(f));
+    for (size_t k = 0; k < n; ++k) {
+      uint32_t idx;
+      in >> idx;
+      EXPECT_EQ(idx, mesh.faceVertices[mesh.faceStart[f] + k]);
+    }
+    int r, g, b;
+    ASSERT_TRUE(bool(in >> r >> g >> b));
+    EXPECT_EQ((Rgb8{uint8_t(r), uint8_t(g), uint8_t(b)}), mesh.faceColors[f]) << f;
+  }
+  // Read by hand: OpenMesh 9.0's OFF reader takes face colours only after a "COFF" header, which other readers
+  // take as per-vertex colours. MeshLab and assimp read this file (tests/cli/export_meshlab.sh, export_assimp.sh).
+  std::string rest;
+  EXPECT_FALSE(bool(in >> rest)) << "trailing " << rest;
+  const VoxelMesh plain = buildVoxelMesh(grid_, scene_, FaceMode::Merged, ColorMode::None);
+  writeVoxelMesh(path("plain.off"), plain);
   PolyMesh m;
-  m.request_face_colors();
-  OpenMesh::IO::Options opt = OpenMesh::IO::Options::FaceColor;
-  ASSERT_TRUE(OpenMesh::IO::read_mesh(m, path("mesh.off"), opt));
-  expectClosedReload(m, mesh);
+  ASSERT_TRUE(OpenMesh::IO::read_mesh(m, path("plain.off")));
+  expectClosedReload(m, plain);
 }
 
-TEST_F(ExportTest, ObjHasVertexColoursAndReloads) {
+TEST_F(ExportTest, ObjSharesVerticesAndGroupsFacesByMaterial) {
   const VoxelMesh plain = buildVoxelMesh(grid_, scene_, FaceMode::Exposed, ColorMode::None);
   writeVoxelMesh(path("plain.obj"), plain);
+  EXPECT_EQ(files(), std::vector<std::string>{"plain.obj"});  // no colour, no .mtl
   PolyMesh m;
   ASSERT_TRUE(OpenMesh::IO::read_mesh(m, path("plain.obj")));
   expectClosedReload(m, plain);
 
-  const VoxelMesh colored = buildVoxelMesh(grid_, scene_, FaceMode::Exposed, ColorMode::Count);
+  const VoxelMesh colored = buildVoxelMesh(grid_, scene_, FaceMode::Merged, ColorMode::Count);
   writeVoxelMesh(path("colored.obj"), colored);
-  std::ifstream in(path("colored.obj"));
-  std::string line;
-  size_t vertices = 0, faces = 0;
-  std::set<std::array<double, 3>> colors;
-  while (std::getline(in, line)) {
-    if (line.rfind("v ", 0) == 0) {
-      std::istringstream s(line.substr(2));
-      double x, y, z, r, g, b;
-      ASSERT_TRUE(bool(s >> x >> y >> z >> r >> g >> b)) << line;
-      colors.insert({r, g, b});
-      ++vertices;
+  EXPECT_EQ(files(), (std::vector<std::string>{"colored.mtl", "colored.obj", "plain.obj"}));
+  // The .mtl: one material per colour, Kd the display colour.
+  std::map<std::string, std::array<double, 3>> kd;
+  {
+    std::ifstream in(path("colored.mtl"));
+    std::string line, current;
+    while (std::getline(in, line)) {
+      std::istringstream s(line);
+      std::string key;
+      s >> key;
+      if (key == "newmtl") s >> current;
+      if (key == "Kd") {
+        std::array<double, 3> c;
+        ASSERT_TRUE(bool(s >> c[0] >> c[1] >> c[2])) << line;
+        kd[current] = c;
+      }
     }
-    faces += line.rfind("f ", 0) == 0;
   }
-  EXPECT_EQ(faces, colored.faceCount());
-  EXPECT_GE(vertices, colored.vertexCount());  // repeated where faces of different colours meet
-  std::set<std::array<double, 3>> expected;
-  for (const Rgb8& c : colored.faceColors) expected.insert({c[0] / 255.0, c[1] / 255.0, c[2] / 255.0});
-  EXPECT_EQ(colors, expected);
+  std::set<Rgb8> distinct(colored.faceColors.begin(), colored.faceColors.end());
+  EXPECT_EQ(kd.size(), distinct.size());
+  // The .obj: shared vertices (as many as the mesh has: no seam along colours), every face under the material of
+  // its colour, each material used for one run of faces.
+  std::ifstream in(path("colored.obj"));
+  std::string line, material;
+  size_t vertices = 0, mtllibs = 0;
+  std::set<std::string> used;
+  std::multiset<std::pair<Rgb8, std::vector<uint32_t>>> want, got;
+  for (size_t f = 0; f < colored.faceCount(); ++f) {
+    const auto first = colored.faceVertices.begin();
+    want.insert({colored.faceColors[f],
+                 std::vector<uint32_t>(first + colored.faceStart[f], first + colored.faceStart[f + 1])});
+  }
+  while (std::getline(in, line)) {
+    std::istringstream s(line);
+    std::string key;
+    s >> key;
+    if (key == "mtllib") {
+      std::string name;
+      s >> name;
+      EXPECT_EQ(name, "colored.mtl");
+      ++mtllibs;
+    } else if (key == "v") {
+      double x, y, z, extra;
+      ASSERT_TRUE(bool(s >> x >> y >> z)) << line;
+      EXPECT_FALSE(bool(s >> extra)) << "vertex colours: " << line;
+      ++vertices;
+    } else if (key == "usemtl") {
+      s >> material;
+      EXPECT_TRUE(used.insert(material).second) << material << " used for two runs of faces";
+      ASSERT_TRUE(kd.count(material)) << material;
+    } else if (key == "f") {
+      ASSERT_FALSE(material.empty());
+      std::vector<uint32_t> face;
+      for (uint32_t i; s >> i;) face.push_back(i - 1);
+      const auto& c = kd[material];
+      auto byte = [](double x) { return uint8_t(std::lround(x * 255)); };
+      got.insert({Rgb8{byte(c[0]), byte(c[1]), byte(c[2])}, face});
+    }
+  }
+  EXPECT_EQ(mtllibs, 1u);
+  EXPECT_EQ(vertices, colored.vertexCount());
+  EXPECT_EQ(used.size(), distinct.size());
+  EXPECT_TRUE(got == want);
+  PolyMesh mc;
+  ASSERT_TRUE(OpenMesh::IO::read_mesh(mc, path("colored.obj")));
+  expectClosedReload(mc, colored);
 }
 
 TEST_F(ExportTest, StlHasTheTriangles) {
@@ -212,31 +305,44 @@ TEST_F(ExportTest, GlbAndGltfReadBackByTinygltfAndImporter) {
                                                         : loader.LoadASCIIFromFile(&model, &err, &warn, path(name));
     ASSERT_TRUE(ok) << err;
     ASSERT_EQ(model.meshes.size(), 1u);
-    const tinygltf::Primitive& prim = model.meshes[0].primitives[0];
-    EXPECT_EQ(prim.mode, TINYGLTF_MODE_TRIANGLES);
-    ASSERT_TRUE(prim.attributes.count("COLOR_0"));
-    const float* pos = accessorData<float>(model, prim.attributes.at("POSITION"));
-    const float* col = accessorData<float>(model, prim.attributes.at("COLOR_0"));
-    const uint32_t* idx = accessorData<uint32_t>(model, prim.indices);
-    const size_t n = model.accessors[size_t(prim.indices)].count;
-    ASSERT_EQ(n, 3 * tris.faceCount());
+    // One primitive per colour over one shared POSITION accessor holding the mesh's vertices once (issue 10: no
+    // seam cut along colours), each with the colour, made linear, as its material's base colour.
+    const std::set<Rgb8> distinct(tris.faceColors.begin(), tris.faceColors.end());
+    const auto& prims = model.meshes[0].primitives;
+    ASSERT_EQ(prims.size(), distinct.size());
+    const int posAcc = prims[0].attributes.at("POSITION");
+    EXPECT_EQ(model.accessors[size_t(posAcc)].count, tris.vertexCount());
+    const float* pos = accessorData<float>(model, posAcc);
     std::vector<Tri> got;
-    for (size_t t = 0; t < n / 3; ++t) {
-      Tri tri;
-      for (int k = 0; k < 3; ++k) {
-        const uint32_t v = idx[3 * t + k];
-        for (int a = 0; a < 3; ++a) tri[k][a] = pos[3 * v + a];
-        // Vertices carry their face's colour, linearised from sRGB.
-        const Rgb8& c = tris.faceColors[t];
-        for (int a = 0; a < 3; ++a) {
-          const double s = c[a] / 255.0;
-          const double linear = s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4);
-          EXPECT_NEAR(col[3 * v + a], linear, 1e-6);
-        }
+    std::map<Tri, std::array<double, 3>> colorOf;  // exact float triangle -> linear colour of its primitive
+    std::set<std::array<double, 3>> seen;
+    for (const tinygltf::Primitive& prim : prims) {
+      EXPECT_EQ(prim.mode, TINYGLTF_MODE_TRIANGLES);
+      EXPECT_EQ(prim.attributes.at("POSITION"), posAcc);
+      EXPECT_FALSE(prim.attributes.count("COLOR_0"));
+      ASSERT_GE(prim.material, 0);
+      const auto& base = model.materials[size_t(prim.material)].pbrMetallicRoughness.baseColorFactor;
+      const std::array<double, 3> linear{base[0], base[1], base[2]};
+      EXPECT_TRUE(seen.insert(linear).second) << "two primitives of one colour";
+      const uint32_t* idx = accessorData<uint32_t>(model, prim.indices);
+      const size_t n = model.accessors[size_t(prim.indices)].count;
+      for (size_t t = 0; t < n / 3; ++t) {
+        Tri tri;
+        for (int k = 0; k < 3; ++k)
+          for (int a = 0; a < 3; ++a) tri[k][a] = pos[3 * idx[3 * t + k] + a];
+        got.push_back(tri);
+        colorOf[*canonical({tri}).begin()] = linear;
       }
-      got.push_back(tri);
     }
     EXPECT_EQ(canonical(got), want);
+    for (size_t f = 0; f < tris.faceCount(); f += 3) {
+      const auto it = colorOf.find(*canonical({expected[f]}).begin());
+      ASSERT_NE(it, colorOf.end());
+      for (int a = 0; a < 3; ++a) {
+        const double s = tris.faceColors[f][size_t(a)] / 255.0;
+        EXPECT_NEAR(it->second[size_t(a)], s <= 0.04045 ? s / 12.92 : std::pow((s + 0.055) / 1.055, 2.4), 1e-12);
+      }
+    }
 
     // The project's own importer sees the same triangles.
     const Scene imported = importGltf(path(name));

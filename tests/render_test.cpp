@@ -324,6 +324,32 @@ TEST(RenderModes, VoxelsDrawOccupiedCellsOnly) {
     }
 }
 
+TEST(ImageIo, DepthIsOneFloatChannelNamedZ) {
+  // Compositors (Blender, Nuke) and OpenImageIO's own conventions take a channel named Z as depth (issue 10).
+  testing::ScratchDir dir("image_io_depth");
+  Image img;
+  img.width = 2;
+  img.height = 2;
+  img.channels = 1;
+  img.pixels = {0, 1.5f, 1e-7f, 12345.678f};
+  for (const char* name : {"d.exr", "d.tif"}) {
+    SCOPED_TRACE(name);
+    writeImage(dir.file(name), img);
+    auto in = OIIO::ImageInput::open(dir.file(name));
+    ASSERT_TRUE(in);
+    const OIIO::ImageSpec& spec = in->spec();
+    ASSERT_EQ(spec.nchannels, 1);
+    EXPECT_EQ(spec.format, OIIO::TypeDesc::FLOAT);
+    if (std::string(name) == "d.exr") {
+      EXPECT_EQ(spec.channelnames[0], "Z");
+      EXPECT_EQ(spec.z_channel, 0);
+    }
+    std::vector<float> px(4);
+    ASSERT_TRUE(in->read_image(0, 0, 0, 1, OIIO::TypeDesc::FLOAT, px.data()));
+    EXPECT_EQ(px, img.pixels);
+  }
+}
+
 TEST(ImageIo, WritesPngAndExrAndRefusesBadPaths) {
   testing::ScratchDir dir("image_io");
   Image img;

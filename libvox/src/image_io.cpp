@@ -52,6 +52,12 @@ bool writePixels(OIIO::ImageOutput& out, const std::string& name, const std::str
   if (channels == 1 && !out.supports("channelformats") && extensionOf(path) == ".hdr") channels = 3;
   OIIO::ImageSpec spec(int(image.width), int(image.height), int(channels),
                        asFloat ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
+  if (asFloat && channels == 1) {
+    // The one single-channel image is depth: named Z, the depth channel of OpenEXR's conventions that Blender's
+    // compositor, Nuke and OpenImageIO itself (z_channel) recognise; OIIO would call it Y.
+    spec.channelnames = {"Z"};
+    spec.z_channel = 0;
+  }
   if (!out.open(name, spec)) {
     error = out.geterror();
     return false;

@@ -649,6 +649,47 @@ VoxelMesh exposedMesh(ExposedSurface&& surface, bool colored) {
 }
 
 // ---------------------------------------------------------------------------------------------------------------
+// Rectangles with extra vertices on their sides as triangles.
+
+// Triangles of one rectangle whose sides carry extra vertices, without zero-area triangles: a fan from the second
+// vertex of the bottom side over the left side, a fan from the second vertex of the top side over the right side,
+// and a zipper between what is left of the bottom and top sides (two parallel lines: every triangle has two
+// vertices on one and one on the other).
+void triangulateRectangle(const std::vector<uint32_t>& poly, const std::vector<Vec3>& pos,
+                          const std::array<size_t, 4>& corner, std::vector<uint32_t>& tris) {
+  const size_t n = poly.size();
+  auto chain = [&](int side) {
+    std::vector<uint32_t> c;
+    for (size_t k = corner[side];; k = (k + 1) % n) {
+      c.push_back(poly[k]);
+      if (k == corner[(side + 1) % 4]) break;
+    }
+    return c;
+  };
+  const auto s0 = chain(0), s1 = chain(1), s2 = chain(2), s3 = chain(3);
+  auto tri = [&](uint32_t a, uint32_t b, uint32_t c) { tris.insert(tris.end(), {a, b, c}); };
+  const uint32_t apex0 = s0[1], apex2 = s2[1];
+  for (size_t j = 0; j + 1 < s3.size(); ++j) tri(s3[j], s3[j + 1], apex0);
+  for (size_t j = 0; j + 1 < s1.size(); ++j) tri(s1[j], s1[j + 1], apex2);
+  const std::vector<uint32_t> bottom(s0.begin() + 1, s0.end());
+  std::vector<uint32_t> top(s2.begin() + 1, s2.end());
+  std::reverse(top.begin(), top.end());  // now runs the same way as bottom
+  const Vec3 dir = pos[s0.back()] - pos[s0.front()];
+  size_t i = 0, j = 0;
+  while (i + 1 < bottom.size() || j + 1 < top.size()) {
+    const bool advanceBottom =
+        j + 1 >= top.size() || (i + 1 < bottom.size() && dot(pos[bottom[i + 1]], dir) <= dot(pos[top[j + 1]], dir));
+    if (advanceBottom) {
+      tri(bottom[i], bottom[i + 1], top[j]);
+      ++i;
+    } else {
+      tri(bottom[i], top[j + 1], top[j]);
+      ++j;
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------------------
 // FaceMode::Merged: greedy meshing of each plane's squares into rectangles of one colour.
 
 VoxelMesh mergedMesh(ExposedSurface&& surface, const std::array<uint32_t, 3>& dims, bool colored) {
@@ -766,18 +807,42 @@ VoxelMesh mergedMesh(ExposedSurface&& surface, const std::array<uint32_t, 3>& di
       if (keep[v].load(std::memory_order_relaxed)) mesh.positions[newId[v]] = surface.positions[v];
   });
 
+  // A rectangle left with its four corners is one quad; one whose sides still carry vertices becomes triangles
+  // without zero-area triangles. Polygons with collinear vertices are what MeshLab (2020.09) triangulates into
+  // zero-area triangles, then reporting non-manifold edges, and what assimp (5.2) fails to triangulate ("no ear
+  // found"): issue 10.
   std::vector<size_t> faceOffset(outs.size() + 1, 0), vertOffset(outs.size() + 1, 0);
   std::vector<std::vector<uint32_t>> kept(outs.size());
   tbb::parallel_for(size_t(0), outs.size(), [&](size_t pi) {
-    const PlaneOut& po = outs[pi];
+    PlaneOut& po = outs[pi];
     std::vector<uint32_t>& kv = kept[pi];
-    std::vector<uint32_t> start{0};
+    std::vector<uint32_t> start{0}, colors, poly, tris;
     for (size_t f = 0; f + 1 < po.start.size(); ++f) {
-      for (uint32_t k = po.start[f]; k < po.start[f + 1]; ++k)
-        if (keep[po.verts[k]].load(std::memory_order_relaxed)) kv.push_back(newId[po.verts[k]]);
-      start.push_back(uint32_t(kv.size()));
+      poly.clear();
+      std::array<size_t, 4> corner{};
+      size_t corners = 0;
+      for (uint32_t k = po.start[f]; k < po.start[f + 1]; ++k) {
+        if (!keep[po.verts[k]].load(std::memory_order_relaxed)) continue;
+        if (po.corner[k]) corner[corners++] = poly.size();
+        poly.push_back(newId[po.verts[k]]);
+      }
+      VOX_CHECK(corners == 4 && corner[0] == 0);
+      if (poly.size() == 4) {
+        kv.insert(kv.end(), poly.begin(), poly.end());
+        start.push_back(uint32_t(kv.size()));
+        colors.push_back(po.colors[f]);
+        continue;
+      }
+      tris.clear();
+      triangulateRectangle(poly, mesh.positions, corner, tris);
+      for (size_t t = 0; t < tris.size(); t += 3) {
+        kv.insert(kv.end(), tris.begin() + ptrdiff_t(t), tris.begin() + ptrdiff_t(t + 3));
+        start.push_back(uint32_t(kv.size()));
+        colors.push_back(po.colors[f]);
+      }
     }
-    outs[pi].start = std::move(start);
+    po.start = std::move(start);
+    po.colors = std::move(colors);
   });
   for (size_t pi = 0; pi < outs.size(); ++pi) {
     faceOffset[pi + 1] = faceOffset[pi] + outs[pi].colors.size();
@@ -838,45 +903,57 @@ int segmentAxis(const Vec3& p, const Vec3& q) {
   return axis;
 }
 
-// Triangles of one rectangle whose sides carry extra vertices, without zero-area triangles: a fan from the second
-// vertex of the bottom side over the left side, a fan from the second vertex of the top side over the right side,
-// and a zipper between what is left of the bottom and top sides (two parallel lines: every triangle has two
-// vertices on one and one on the other).
-void triangulateRectangle(const std::vector<uint32_t>& poly, const std::vector<Vec3>& pos, const std::array<size_t, 4>& corner,
-                          std::vector<uint32_t>& tris) {
-  const size_t n = poly.size();
-  auto chain = [&](int side) {
-    std::vector<uint32_t> c;
-    for (size_t k = corner[side];; k = (k + 1) % n) {
-      c.push_back(poly[k]);
-      if (k == corner[(side + 1) % 4]) break;
-    }
-    return c;
+}  // namespace
+
+std::vector<Rgb8> dominantVertexColors(const VoxelMesh& mesh) {
+  if (!mesh.hasColors()) return {};
+  const size_t nv = mesh.vertexCount(), nf = mesh.faceCount();
+  // Corners grouped by vertex (counting sort), then a small tally per vertex: voxel meshes have a handful of
+  // corners per vertex.
+  std::vector<uint32_t> cornerStart(nv + 1, 0);
+  for (uint32_t v : mesh.faceVertices) ++cornerStart[v + 1];
+  for (size_t v = 0; v < nv; ++v) cornerStart[v + 1] += cornerStart[v];
+  struct Corner {
+    uint32_t color;
+    double angle;
   };
-  const auto s0 = chain(0), s1 = chain(1), s2 = chain(2), s3 = chain(3);
-  auto tri = [&](uint32_t a, uint32_t b, uint32_t c) { tris.insert(tris.end(), {a, b, c}); };
-  const uint32_t apex0 = s0[1], apex2 = s2[1];
-  for (size_t j = 0; j + 1 < s3.size(); ++j) tri(s3[j], s3[j + 1], apex0);
-  for (size_t j = 0; j + 1 < s1.size(); ++j) tri(s1[j], s1[j + 1], apex2);
-  const std::vector<uint32_t> bottom(s0.begin() + 1, s0.end());
-  std::vector<uint32_t> top(s2.begin() + 1, s2.end());
-  std::reverse(top.begin(), top.end());  // now runs the same way as bottom
-  const Vec3 dir = pos[s0.back()] - pos[s0.front()];
-  size_t i = 0, j = 0;
-  while (i + 1 < bottom.size() || j + 1 < top.size()) {
-    const bool advanceBottom =
-        j + 1 >= top.size() || (i + 1 < bottom.size() && dot(pos[bottom[i + 1]], dir) <= dot(pos[top[j + 1]], dir));
-    if (advanceBottom) {
-      tri(bottom[i], bottom[i + 1], top[j]);
-      ++i;
-    } else {
-      tri(bottom[i], top[j + 1], top[j]);
-      ++j;
+  std::vector<Corner> corners(mesh.faceVertices.size());
+  {
+    std::vector<uint32_t> cursor(cornerStart.begin(), cornerStart.end() - 1);
+    for (size_t f = 0; f < nf; ++f) {
+      const uint32_t b = mesh.faceStart[f], e = mesh.faceStart[f + 1], n = e - b;
+      const uint32_t color = packColor(mesh.faceColors[f]);
+      for (uint32_t k = 0; k < n; ++k) {
+        const uint32_t u = mesh.faceVertices[b + (k + n - 1) % n], v = mesh.faceVertices[b + k],
+                       w = mesh.faceVertices[b + (k + 1) % n];
+        const Vec3 a = mesh.positions[u] - mesh.positions[v], c = mesh.positions[w] - mesh.positions[v];
+        corners[cursor[v]++] = {color, std::atan2(length(cross(a, c)), dot(a, c))};
+      }
     }
   }
+  std::vector<Rgb8> colors(nv, Rgb8{255, 255, 255});
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv), [&](const tbb::blocked_range<size_t>& r) {
+    std::vector<std::pair<uint32_t, double>> tally;
+    for (size_t v = r.begin(); v != r.end(); ++v) {
+      tally.clear();
+      for (uint32_t k = cornerStart[v]; k < cornerStart[v + 1]; ++k) {
+        auto it = std::find_if(tally.begin(), tally.end(), [&](const auto& t) { return t.first == corners[k].color; });
+        if (it == tally.end())
+          tally.push_back({corners[k].color, corners[k].angle});
+        else
+          it->second += corners[k].angle;
+      }
+      if (tally.empty()) continue;
+      // Packed as 0x01BBGGRR; compare as (r, g, b) for the documented tie rule.
+      auto rgbKey = [](uint32_t c) { return ((c & 0xFF) << 16) | (c & 0xFF00) | ((c >> 16) & 0xFF); };
+      auto best = tally.front();
+      for (const auto& t : tally)
+        if (t.second > best.second || (t.second == best.second && rgbKey(t.first) < rgbKey(best.first))) best = t;
+      colors[v] = unpackColor(best.first);
+    }
+  });
+  return colors;
 }
-
-}  // namespace
 
 VoxelMesh triangulateVoxelMesh(const VoxelMesh& mesh) {
   const size_t nf = mesh.faceCount();

@@ -47,7 +47,11 @@ head -c 300 "$tmp/m_exposed.ply" | grep -q "property uchar red" || fail "PLY wit
 expect_code 0 "ascii ply" "$export_tool" "$tmp/g.vgrid" -o "$tmp/a.ply" --ascii --color none --quiet
 head -c 200 "$tmp/a.ply" | grep -q "format ascii" || fail "--ascii PLY not ASCII"
 grep -q "red" "$tmp/a.ply" && fail "--color none wrote colours"
-grep -m1 '^v ' "$tmp/m_exposed.obj" | awk 'NF != 7 { exit 1 }' || fail "OBJ vertices without colours"
+# OBJ colours: shared vertices, faces grouped by usemtl, materials in a .mtl beside the .obj (issue 10).
+grep -qx 'mtllib m_exposed.mtl' "$tmp/m_exposed.obj" || fail "OBJ without mtllib m_exposed.mtl"
+grep -q '^usemtl vox_' "$tmp/m_exposed.obj" || fail "OBJ without usemtl"
+grep -q '^Kd ' "$tmp/m_exposed.mtl" 2>/dev/null || fail "no materials in m_exposed.mtl"
+head -c 4 "$tmp/m_exposed.off" | grep -qx 'OFF' || fail "OFF header is not OFF: $(head -1 "$tmp/m_exposed.off")"
 expect_code 0 "material colours" "$export_tool" "$tmp/g.vgrid" -o "$tmp/mat.ply" --color material --threads 1 --quiet
 
 # --stats: name: value lines on stderr, nothing on stdout.

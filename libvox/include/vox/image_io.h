@@ -15,7 +15,7 @@ bool imageFormatHoldsFloat(const std::string& path);
 // Writes `image` to `path` through a temporary file in the same folder (keeping the extension, since OpenImageIO
 // picks the format from it) and a rename. Float formats get the values as they are; 8-bit formats get them clamped
 // to [0, 1] and rounded. Throws UsageError for an unknown extension, OutputError when the file cannot be written
-// (no partial file is left behind).
+// (no partial file is left behind). A one-channel image (depth) is written to float formats as a channel named Z.
 void writeImage(const std::string& path, const Image& image);
 
 }  // namespace vox

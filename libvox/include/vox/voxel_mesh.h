@@ -16,7 +16,8 @@ namespace vox {
 enum class FaceMode : uint8_t {
   All,      // one closed cube per voxel: 8 own vertices, 12 triangles
   Exposed,  // unit squares between a voxel and an empty cell (or the outside), vertices shared: closed, 2-manifold
-  Merged,   // the exposed squares merged into maximal same-coloured rectangles: closed, 2-manifold, no T-junctions
+  Merged,   // the exposed squares merged into same-coloured rectangles (quads, or triangles where sides carry
+            // vertices): closed, 2-manifold, no T-junctions
 };
 enum class ColorMode : uint8_t {
   Count,     // countColor(primitives in the cell, largest count in the grid)
@@ -67,8 +68,11 @@ struct VoxelMeshStats {
 //    they are joined by face-adjacent voxels around both ends of the edge (then the empty cells are kept apart:
 //    the other choice would put four faces on one edge).
 //  - Merged: the exposed squares of each plane and orientation merged greedily into rectangles of one colour.
-//    Each rectangle is a polygon listing every vertex of the mesh that lies on its sides, so there is no
-//    T-junction; vertices that are a corner of no rectangle are dropped.
+//    A rectangle's sides hold every vertex of the mesh that lies on them, so there is no T-junction; vertices that
+//    are a corner of no rectangle are dropped. A rectangle with only its four corners is one quad; one with more
+//    vertices on its sides is written as triangles (n vertices: n - 2 triangles, none of zero area), because
+//    clients triangulate polygons with collinear vertices badly (MeshLab into zero-area triangles, assimp not at
+//    all). So every face is a triangle or a rectangle, and there are at most two triangles' worth per square.
 // Colours: per voxel face, from `color`; solid cells get kSolidCellColor. In Merged mode only faces of equal 8-bit
 // colour merge. Memory and time grow with the number of voxels, not with the grid's dimensions. Work is spread over
 // the TBB arena of the caller. Throws InputError when a cell key lies outside the grid or a primitive id or
@@ -81,19 +85,28 @@ VoxelMesh buildVoxelMesh(const Grid& grid, const Scene& scene, FaceMode faces, C
 // vertices (what buildVoxelMesh produces). Colours follow their faces.
 VoxelMesh triangulateVoxelMesh(const VoxelMesh& mesh);
 
+// One colour per vertex for clients that read vertex colours only (Blender's and assimp's PLY importers): the face
+// colour that covers the largest angle around the vertex (ties: the smallest colour, as bytes r, g, b), so that a
+// vertex inside a region of one colour gets exactly that colour and the mesh keeps its shared vertices. Empty
+// when the mesh has no colours. Precondition: every face has at least three vertices.
+std::vector<Rgb8> dominantVertexColors(const VoxelMesh& mesh);
+
 // Mesh file formats, chosen by the extension of the output path (case-insensitive).
 enum class MeshFormat : uint8_t { Ply, Obj, Off, Stl, Glb, Gltf };
 // Throws InputError naming the path for an unknown extension.
 MeshFormat meshFormatFromPath(const std::string& path);
 
 // Writes `mesh` to `path` in the format of its extension, through a temporary file and a rename (writeAtomically):
-//  - .ply (OpenMesh; binary little-endian unless binary is false): polygons, per-face uchar colours.
-//  - .off (OpenMesh; always ASCII, the form other readers expect): polygons, per-face colours.
-//  - .obj (written here, ASCII): polygons, "v x y z r g b" vertex colours (the extension MeshLab and Blender read);
-//    with colours, vertices are repeated per colour so that each face shows its own colour.
+// Every format keeps the mesh's shared vertices (no seam is cut along colour boundaries):
+//  - .ply (OpenMesh; binary little-endian unless binary is false): the faces, per-face uchar colours (MeshLab) and
+//    per-vertex uchar colours from dominantVertexColors (Blender and assimp read vertex colours only).
+//  - .off (ASCII, "OFF" header): the faces, each followed by its colour as three integers 0..255.
+//  - .obj (ASCII): the faces; with colours, grouped by "usemtl vox_RRGGBB" under "mtllib NAME.mtl", and NAME.mtl
+//    (the output's name with the extension .mtl) written beside it, Kd the sRGB display colour in [0, 1]. An OBJ
+//    written to a character device or FIFO gets no .mtl.
 //  - .stl (OpenMesh; binary unless binary is false): triangles, no colour.
-//  - .glb, .gltf (tinygltf; buffers embedded): one triangle primitive, COLOR_0 vertex colours (linear, converted
-//    from the sRGB face colours), vertices repeated per colour; glTF viewers compute flat normals.
+//  - .glb, .gltf (tinygltf; buffers embedded): one POSITION accessor shared by one triangle primitive per colour,
+//    each with a matte material whose baseColorFactor is the colour made linear; viewers compute flat normals.
 // Throws InputError for an unknown extension, OutputError when the file cannot be written.
 void writeVoxelMesh(const std::string& path, const VoxelMesh& mesh, bool binary = true);
 

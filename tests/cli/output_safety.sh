@@ -94,27 +94,43 @@ else
   skip "full tmpfs: not root or mount refused (the ulimit -f checks above stand in)"
 fi
 
-# Devices: written into, never replaced by a regular file.
-expect_code 3 "voxelize -o /dev/full" "$V" "$src/scenes/scene5_01_sphere.txt" -o /dev/full --grid 3 3 3 -q
-grep -q "No space left on device" "$tmp/err" || fail "/dev/full: message lacks the reason: $(head -c 200 "$tmp/err")"
-[ -c /dev/full ] || fail "/dev/full is no longer a character device"
-if [ "$(id -u)" = 0 ]; then
-  expect_code 0 "voxelize -o /dev/null" "$V" "$src/scenes/scene5_01_sphere.txt" -o /dev/null --grid 3 3 3 -q
-  [ -c /dev/null ] || fail "/dev/null is no longer a character device"
-  # Export and trace take the format from the extension: device nodes of their own with one.
-  if mknod "$tmp/null.ply" c 1 3 && mknod "$tmp/full.png" c 1 7 && mknod "$tmp/blk.ply" b 7 0; then
-    expect_code 0 "export into a null device" "$E" "$tmp/small.vgrid" -o "$tmp/null.ply" -q
-    [ -c "$tmp/null.ply" ] || fail "null.ply is no longer a character device"
-    expect_code 3 "trace into a full device" "$T" "$tmp/small.vgrid" -o "$tmp/full.png" --size 64 64 -q
-    [ -c "$tmp/full.png" ] || fail "full.png is no longer a character device"
-    expect_code 3 "export into a block device" "$E" "$tmp/small.vgrid" -o "$tmp/blk.ply" -q
-    [ -b "$tmp/blk.ply" ] || fail "blk.ply is no longer a block device"
-    rm -f "$tmp/null.ply" "$tmp/full.png" "$tmp/blk.ply"
+# Devices: written into, never replaced by a regular file. As root a broken tool would replace the machine's own
+# /dev/null and /dev/full, so private nodes are tried first, the real ones only when those survive, and any real
+# node found replaced is put back.
+sphere="$src/scenes/scene5_01_sphere.txt"
+restore_node() {  # restore_node PATH MAJOR MINOR
+  [ -c "$1" ] && return 0
+  fail "$1 is no longer a character device (restored)"
+  mknod -m 666 "$1.vox-restore" c "$2" "$3" && mv -f "$1.vox-restore" "$1"
+}
+if [ "$(id -u)" != 0 ]; then
+  # Not root: the folder /dev is not writable, so nothing can be replaced there.
+  expect_code 3 "voxelize -o /dev/full" "$V" "$sphere" -o /dev/full --grid 3 3 3 -q
+  grep -q "No space left on device" "$tmp/err" || fail "/dev/full: message lacks the reason: $(head -c 99 "$tmp/err")"
+  skip "/dev/null as output and device nodes of our own: need root (the FIFO checks below stand in)"
+elif mknod "$tmp/null.vgrid" c 1 3 && mknod "$tmp/full.vgrid" c 1 7 && mknod "$tmp/null.ply" c 1 3 &&
+  mknod "$tmp/full.png" c 1 7 && mknod "$tmp/blk.ply" b 7 0; then
+  before=$failures
+  expect_code 0 "voxelize into a null device" "$V" "$sphere" -o "$tmp/null.vgrid" --grid 3 3 3 -q
+  expect_code 3 "voxelize into a full device" "$V" "$sphere" -o "$tmp/full.vgrid" --grid 3 3 3 -q
+  grep -q "No space left on device" "$tmp/err" || fail "full device: message lacks the reason: $(head -c 99 "$tmp/err")"
+  # Export and trace take the format from the extension: nodes with one.
+  expect_code 0 "export into a null device" "$E" "$tmp/small.vgrid" -o "$tmp/null.ply" -q
+  expect_code 3 "trace into a full device" "$T" "$tmp/small.vgrid" -o "$tmp/full.png" --size 64 64 -q
+  expect_code 3 "export into a block device" "$E" "$tmp/small.vgrid" -o "$tmp/blk.ply" -q
+  for node in null.vgrid full.vgrid null.ply full.png; do [ -c "$tmp/$node" ] || fail "$node: not a device"; done
+  [ -b "$tmp/blk.ply" ] || fail "blk.ply is no longer a block device"
+  rm -f "$tmp/null.vgrid" "$tmp/full.vgrid" "$tmp/null.ply" "$tmp/full.png" "$tmp/blk.ply"
+  if [ "$failures" = "$before" ]; then
+    expect_code 3 "voxelize -o /dev/full" "$V" "$sphere" -o /dev/full --grid 3 3 3 -q
+    restore_node /dev/full 1 7
+    expect_code 0 "voxelize -o /dev/null" "$V" "$sphere" -o /dev/null --grid 3 3 3 -q
+    restore_node /dev/null 1 3
   else
-    skip "mknod refused: device nodes with an extension not checked"
+    fail "/dev/null and /dev/full not tried: the tools replaced device nodes of their own"
   fi
 else
-  skip "/dev/null as output: only root could have it replaced (the FIFO checks below stand in)"
+  skip "mknod refused: /dev/null, /dev/full and other device nodes as outputs not checked"
 fi
 
 # FIFOs: written into when read, refused at once when nobody reads.

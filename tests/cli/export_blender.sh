@@ -50,7 +50,8 @@ for grid in $grids; do
       [ "$grid" = small ] && [ "$faces" = merged ] && exts="ply obj glb gltf"
       for ext in $exts; do
         mesh="$tmp/${grid}_${faces}_$color.$ext"
-        "$build/vox-export" "$tmp/$grid.vgrid" -o "$mesh" --faces "$faces" --color "$color" --stats --quiet 2>"$tmp/stats" ||
+        "$build/vox-export" "$tmp/$grid.vgrid" -o "$mesh" --faces "$faces" --color "$color" --stats --quiet \
+          2>"$tmp/stats" ||
           { fail "export $mesh"; continue; }
         vertices=$(sed -n 's/^vertices: //p' "$tmp/stats") count=$(sed -n 's/^faces: //p' "$tmp/stats")
         echo "$mesh $vertices $count $triangles $color" >>"$tmp/expect"

@@ -52,6 +52,29 @@ done
 expect 0 "count mode prints its scale" -- "$TRACE" "$WORK/b.vgrid" -o "$WORK/c.png" --size 20 20 --mode count --stats -q
 grep -Eq '^count_scale_max: [0-9.]+$' "$WORK/err.txt" || fail "count mode: no count_scale_max line"
 expect 0 "depth to EXR" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/d.exr" --size 20 20 --mode depth -q
+# Its channel list (OpenEXR header attribute "channels", type chlist): one float channel named Z, the name
+# compositors take as depth (issue 10; OpenImageIO's default for one channel is Y).
+channels=$(python3 - "$WORK/d.exr" <<'PY'
+import struct, sys
+data = open(sys.argv[1], "rb").read()
+at = 8  # magic and version
+while data[at] != 0:
+    name_end = data.index(b"\0", at)
+    type_end = data.index(b"\0", name_end + 1)
+    size = struct.unpack_from("<i", data, type_end + 1)[0]
+    value = data[type_end + 5:type_end + 5 + size]
+    if data[at:name_end] == b"channels":
+        out, k = [], 0
+        while value[k] != 0:
+            end = value.index(b"\0", k)
+            pixel_type = struct.unpack_from("<i", value, end + 1)[0]
+            out.append("%s:%s" % (value[k:end].decode(), {0: "uint", 1: "half", 2: "float"}[pixel_type]))
+            k = end + 17
+        print(" ".join(out))
+    at = type_end + 5 + size
+PY
+)
+[ "$channels" = "Z:float" ] || fail "depth EXR channels are '$channels', expected one float channel Z"
 expect 0 "voxels, samples, camera overrides, threads" -- "$TRACE" "$WORK/b.vgrid" -o "$WORK/v.tga" --size 30 20 \
   --mode voxels --samples 4 --eye 0 0.3 1 --look-at 0 0.2 0 --up 0 1 0 --fov 40 --threads 1 -q
 

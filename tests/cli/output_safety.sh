@@ -193,6 +193,7 @@ set +m
 cp "$src/scenes/cube.obj" "$tmp/scene.obj"
 cp "$tmp/small.vgrid" "$tmp/grid.ply"
 cp "$tmp/small.vgrid" "$tmp/grid.png"
+cp "$tmp/small.vgrid" "$tmp/grid.mtl"
 ln -s scene.obj "$tmp/scene_link.obj"
 ln "$tmp/grid.ply" "$tmp/grid_hard.ply"
 ln -s grid.png "$tmp/grid_link.png"
@@ -201,6 +202,7 @@ cp "$tmp/small.vgrid" "$tmp/grid.ref"
 for case in "voxelize|$V $tmp/scene.obj -o $tmp/scene.obj" \
             "voxelize via symlink|$V $tmp/scene.obj -o $tmp/scene_link.obj" \
             "export|$E $tmp/grid.ply -o $tmp/grid.ply" "export via hard link|$E $tmp/grid.ply -o $tmp/grid_hard.ply" \
+            "export OBJ whose .mtl is the grid|$E $tmp/grid.mtl -o $tmp/grid.obj" \
             "trace|$T $tmp/grid.png -o $tmp/grid.png" "trace via symlink|$T $tmp/grid_link.png -o $tmp/grid.png"; do
   IFS='|' read -r what cmd <<<"$case"
   expect_code 1 "output is input: $what" $cmd
@@ -209,6 +211,7 @@ done
 cmp -s "$tmp/scene.obj" "$tmp/scene.ref" || fail "output is input: the scene changed"
 cmp -s "$tmp/grid.ply" "$tmp/grid.ref" || fail "output is input: the grid (export) changed"
 cmp -s "$tmp/grid.png" "$tmp/grid.ref" || fail "output is input: the grid (trace) changed"
+cmp -s "$tmp/grid.mtl" "$tmp/grid.ref" || fail "output is input: the grid named .mtl changed"
 [ -L "$tmp/scene_link.obj" ] && [ -L "$tmp/grid_link.png" ] || fail "output is input: a symlink was replaced"
 expect_clean "$tmp" "output is input"
 

@@ -38,6 +38,9 @@ int run(const Options& opt) {
     throw UsageError(e.what());
   }
   checkOutputPath(opt.output, {opt.grid});
+  // An OBJ writes its materials to NAME.mtl beside it: that second output must not be the grid either.
+  if (meshFormatFromPath(opt.output) == MeshFormat::Obj)
+    checkOutputPath(std::filesystem::path(opt.output).replace_extension(".mtl").string(), {opt.grid});
   const FaceMode faces = parseFaceMode(opt.faces);
   const ColorMode color = parseColorMode(opt.color);
 

@@ -4,7 +4,6 @@
 
 #include <bit>
 #include <cstring>
-#include <fstream>
 #include <limits>
 
 #include "vox/atomic_file.h"

@@ -5,7 +5,6 @@
 #include <charconv>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -25,15 +24,6 @@ struct Token {
   std::string_view text;
   int line = 0;
 };
-
-std::string readWholeFile(const std::string& path, const char* what) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail<InputError>(path, ": cannot open ", what);
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  if (in.bad()) fail<InputError>(path, ": read error");
-  return buffer.str();
-}
 
 bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v'; }
 
@@ -106,7 +96,7 @@ std::optional<double> similarityScale(const Mat4& t) {
 class CourseParser {
  public:
   explicit CourseParser(std::string path) : path_(std::move(path)) {
-    text_ = readWholeFile(path_, "scene file");
+    text_ = readInputFile(path_, "scene file");
     tokens_ = tokenize(text_);
     folder_ = std::filesystem::path(path_).parent_path();
   }

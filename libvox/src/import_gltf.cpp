@@ -20,7 +20,6 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -582,13 +581,13 @@ void checkExternalUris(const std::string& path, std::string_view json) {
   }
 }
 
-// tinygltf's messages are several lines; ours are one.
-std::string oneLine(const std::string& text) {
-  std::string out;
+// tinygltf's messages and warnings come as lines, some empty; ours are one line each.
+std::vector<std::string> nonEmptyLines(const std::string& text) {
+  std::vector<std::string> out;
   std::istringstream lines(text);
   std::string line;
   while (std::getline(lines, line))
-    if (!trimmed(line).empty()) out += (out.empty() ? "" : "; ") + trimmed(line);
+    if (!trimmed(line).empty()) out.push_back(trimmed(line));
   return out;
 }
 
@@ -596,11 +595,14 @@ std::string oneLine(const std::string& text) {
 
 Scene importGltf(const std::string& path) {
   const std::string bytes = readInputFile(path, "glTF file");
+  // tinygltf takes the size as an unsigned int: a larger file would be cut silently.
+  if (bytes.size() > std::numeric_limits<unsigned>::max())
+    fail<InputError>(path, ": ", bytes.size(), " bytes; tinygltf reads glTF files of at most 4 GiB");
   const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
-  if (jsonDepth(jsonPart(bytes, binary)) > kMaxJsonDepth)
-    fail<InputError>(path, ": JSON nested deeper than ", kMaxJsonDepth, " levels");
+  const std::string_view json = jsonPart(bytes, binary);
+  if (jsonDepth(json) > kMaxJsonDepth) fail<InputError>(path, ": JSON nested deeper than ", kMaxJsonDepth, " levels");
 
-  checkExternalUris(path, jsonPart(bytes, binary));
+  checkExternalUris(path, json);
   FolderGuard guard{path, {}};
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(skipImage, nullptr);
@@ -613,14 +615,15 @@ Scene importGltf(const std::string& path) {
   const bool ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, unsigned(bytes.size()), baseDir)
                          : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), baseDir);
   if (!guard.refusal.empty()) throw InputError(guard.refusal);
-  if (!ok) fail<InputError>(path, ": ", err.empty() ? std::string("cannot read glTF file") : quoteInput(oneLine(err), 300));
+  if (!ok) {
+    std::string message;
+    for (const std::string& line : nonEmptyLines(err)) message += (message.empty() ? "" : "; ") + line;
+    fail<InputError>(path, ": ", message.empty() ? std::string("cannot read glTF file") : quoteInput(message, 300));
+  }
   checkInstancedTriangles(path, model);
 
   Scene scene = GltfReader(path, model).read();
-  std::istringstream lines(warn);
-  std::string line;
-  while (std::getline(lines, line))
-    if (!trimmed(line).empty()) scene.warnings.push_back(path + ": " + quoteInput(trimmed(line), 300));
+  for (const std::string& line : nonEmptyLines(warn)) scene.warnings.push_back(path + ": " + quoteInput(line, 300));
   return scene;
 }
 

@@ -51,23 +51,9 @@ inline void loadSceneBytes(std::string_view bytes, const std::string& extension)
   }
 }
 
-// Decodes `bytes` as a grid file after rewriting the header's payload size (offset 16) and checksum (offset 24),
-// so that mutations reach the reader's own checks of counts, offsets and ids instead of stopping at the checksum
-// (docs/grid-format.md). What decodes is traced and exported, as tests/grid_file_test.cpp's structure fuzzing does.
-inline void decodeGridBytes(std::string bytes) {
-  constexpr size_t kHeader = 32;
-  if (bytes.size() >= kHeader) {
-    const uint64_t size = bytes.size() - kHeader;
-    const uint64_t sum = gridChecksum(bytes.data() + kHeader, size);
-    std::memcpy(&bytes[16], &size, 8);
-    std::memcpy(&bytes[24], &sum, 8);
-  }
-  GridFile file;
-  try {
-    file = decodeGridFile(bytes, "fuzz.vgrid");
-  } catch (const Error&) {
-    return;
-  }
+// What a decoded grid file must survive: tracing in three modes and meshing. vox::Error is an acceptable answer,
+// a crash is not. Shared by the fuzz target and tests/grid_file_test.cpp's structure fuzzing.
+inline void exerciseDecodedGrid(const GridFile& file) {
   try {
     const Accel accel = buildAccel(file.scene, file.grid, AccelKind::Grid);
     RenderOptions options;
@@ -82,6 +68,26 @@ inline void decodeGridBytes(std::string bytes) {
     buildVoxelMesh(file.grid, file.scene, FaceMode::Merged, ColorMode::Material);
   } catch (const Error&) {
   }
+}
+
+// Decodes `bytes` as a grid file after rewriting the header's payload size (offset 16) and checksum (offset 24),
+// so that mutations reach the reader's own checks of counts, offsets and ids instead of stopping at the checksum
+// (docs/grid-format.md). What decodes is traced and exported (exerciseDecodedGrid).
+inline void decodeGridBytes(std::string bytes) {
+  constexpr size_t kHeader = 32;
+  if (bytes.size() >= kHeader) {
+    const uint64_t size = bytes.size() - kHeader;
+    const uint64_t sum = gridChecksum(bytes.data() + kHeader, size);
+    std::memcpy(&bytes[16], &size, 8);
+    std::memcpy(&bytes[24], &sum, 8);
+  }
+  GridFile file;
+  try {
+    file = decodeGridFile(bytes, "fuzz.vgrid");
+  } catch (const Error&) {
+    return;
+  }
+  exerciseDecodedGrid(file);
 }
 
 }  // namespace vox::fuzz

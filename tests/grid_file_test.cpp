@@ -13,6 +13,8 @@
 #include "vox/grid_file.h"
 #include "vox/voxelize.h"
 
+#include "../fuzz/fuzz_entry.h"
+
 namespace vox {
 namespace {
 
@@ -195,22 +197,8 @@ TEST(GridFile, MutationsWithValidChecksumDecodeOrThrow) {
     std::memcpy(&m[24], &sum, 8);
     try {
       const GridFile file = decodeGridFile(m, "fuzz.vgrid");
-      // What decodes must also be safe to trace and export: vox::Error is an acceptable answer, a crash is not.
-      if (++accepted <= 300) {
-        try {
-          const Accel accel = buildAccel(file.scene, file.grid, AccelKind::Grid);
-          RenderOptions ro;
-          ro.width = ro.height = 6;
-          const auto b = sceneBounds(file.scene);
-          ro.camera = file.scene.camera ? *file.scene.camera : defaultCamera(b ? *b : file.grid.bounds);
-          for (RenderMode mode : {RenderMode::Shade, RenderMode::Voxels, RenderMode::Depth}) {
-            ro.mode = mode;
-            traceImage(file.scene, accel, ro);
-          }
-          buildVoxelMesh(file.grid, file.scene, FaceMode::Merged, ColorMode::Material);
-        } catch (const Error&) {
-        }
-      }
+      // What decodes must also be safe to trace and export, exactly as the grid fuzz target checks it.
+      if (++accepted <= 300) fuzz::exerciseDecodedGrid(file);
     } catch (const InputError& e) {
       ASSERT_NE(std::string(e.what()).find("fuzz.vgrid"), std::string::npos);
       ++refused;

@@ -7,9 +7,9 @@
 #include <filesystem>
 #include <string>
 
-#include "vox/import.h"
-#include "vox/voxel_mesh.h"
-#include "vox/voxelize.h"
+#include "vox/import/import.h"
+#include "vox/export/voxel_mesh.h"
+#include "vox/voxelize/voxelize.h"
 
 namespace {
 

@@ -23,12 +23,12 @@
 #include <string>
 #include <vector>
 
-#include "vox/accel.h"
-#include "vox/import.h"
-#include "vox/render.h"
-#include "vox/trace_packet.h"
-#include "vox/traverse.h"
-#include "vox/voxelize.h"
+#include "vox/trace/accel.h"
+#include "vox/import/import.h"
+#include "vox/trace/render.h"
+#include "vox/trace/trace_packet.h"
+#include "vox/trace/traverse.h"
+#include "vox/voxelize/voxelize.h"
 
 namespace {
 

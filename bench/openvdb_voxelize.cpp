@@ -9,8 +9,8 @@
 #include <chrono>
 #include <cstdio>
 
-#include "vox/import.h"
-#include "vox/voxelize.h"
+#include "vox/import/import.h"
+#include "vox/voxelize/voxelize.h"
 
 int main(int argc, char** argv) {
   if (argc < 3) {

@@ -7,7 +7,7 @@
 #include <cstdlib>
 
 #include "adversary.h"
-#include "vox/overlap.h"
+#include "vox/voxelize/overlap.h"
 
 int main(int argc, char** argv) {
   using namespace vox;

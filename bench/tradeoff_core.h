@@ -10,11 +10,11 @@
 #include <string>
 #include <vector>
 
-#include "vox/accel.h"
-#include "vox/error.h"
-#include "vox/import.h"
-#include "vox/render.h"
-#include "vox/voxelize.h"
+#include "vox/trace/accel.h"
+#include "vox/core/error.h"
+#include "vox/import/import.h"
+#include "vox/trace/render.h"
+#include "vox/voxelize/voxelize.h"
 
 namespace vox::bench {
 

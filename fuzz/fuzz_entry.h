@@ -11,12 +11,12 @@
 #include <string>
 #include <string_view>
 
-#include "vox/accel.h"
-#include "vox/error.h"
-#include "vox/grid_file.h"
-#include "vox/import.h"
-#include "vox/render.h"
-#include "vox/voxel_mesh.h"
+#include "vox/trace/accel.h"
+#include "vox/core/error.h"
+#include "vox/io/grid_file.h"
+#include "vox/import/import.h"
+#include "vox/trace/render.h"
+#include "vox/export/voxel_mesh.h"
 
 namespace vox::fuzz {
 

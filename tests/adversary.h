@@ -7,8 +7,8 @@
 #include <cmath>
 #include <random>
 
-#include "vox/grid.h"
-#include "vox/scene.h"
+#include "vox/core/grid.h"
+#include "vox/core/scene.h"
 
 namespace vox::testing {
 

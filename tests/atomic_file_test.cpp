@@ -15,8 +15,8 @@
 #include <thread>
 
 #include "test_util.h"
-#include "vox/atomic_file.h"
-#include "vox/error.h"
+#include "vox/io/atomic_file.h"
+#include "vox/core/error.h"
 
 namespace vox {
 namespace {

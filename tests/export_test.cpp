@@ -18,9 +18,9 @@
 #include <set>
 #include <tiny_gltf.h>
 
-#include "vox/error.h"
-#include "vox/import.h"
-#include "vox/voxel_mesh.h"
+#include "vox/core/error.h"
+#include "vox/import/import.h"
+#include "vox/export/voxel_mesh.h"
 
 namespace vox {
 namespace {

@@ -2,9 +2,9 @@
 #include <gtest/gtest.h>
 
 #include "test_util.h"
-#include "vox/error.h"
-#include "vox/fill.h"
-#include "vox/voxelize.h"
+#include "vox/core/error.h"
+#include "vox/voxelize/fill.h"
+#include "vox/voxelize/voxelize.h"
 
 namespace vox {
 namespace {

@@ -6,12 +6,12 @@
 #include <random>
 
 #include "test_util.h"
-#include "vox/accel.h"
-#include "vox/error.h"
-#include "vox/render.h"
-#include "vox/voxel_mesh.h"
-#include "vox/grid_file.h"
-#include "vox/voxelize.h"
+#include "vox/trace/accel.h"
+#include "vox/core/error.h"
+#include "vox/trace/render.h"
+#include "vox/export/voxel_mesh.h"
+#include "vox/io/grid_file.h"
+#include "vox/voxelize/voxelize.h"
 
 #include "../fuzz/fuzz_entry.h"
 

@@ -1,6 +1,6 @@
 // Tests for the scene importers (import_course.cpp, import_obj.cpp, import_gltf.cpp, import_ply.cpp,
 // load_scene.cpp): counts of the seed scenes, transforms against hand-computed values, and bad input.
-#include "vox/import.h"
+#include "vox/import/import.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "vox/error.h"
+#include "vox/core/error.h"
 
 namespace vox {
 namespace {

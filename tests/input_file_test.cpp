@@ -1,5 +1,5 @@
 // Tests of the untrusted-input guards: folder confinement, regular files only, memory budget, quoting.
-#include "vox/input_file.h"
+#include "vox/io/input_file.h"
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>
@@ -8,8 +8,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "cell_range.h"
-#include "vox/error.h"
+#include "voxelize/cell_range.h"
+#include "vox/core/error.h"
 
 namespace vox {
 namespace {

@@ -6,10 +6,10 @@
 #include <random>
 #include <vector>
 
-#include "vox/grid.h"
-#include "vox/ray.h"
-#include "vox/scene.h"
-#include "vox/voxelize.h"
+#include "vox/core/grid.h"
+#include "vox/trace/ray.h"
+#include "vox/core/scene.h"
+#include "vox/voxelize/voxelize.h"
 
 namespace vox::testing {
 

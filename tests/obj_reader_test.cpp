@@ -1,7 +1,7 @@
 // Tests for the OBJ / MTL reader (obj_reader.cpp) and the OBJ importer built on it (import_obj.cpp): exact
 // numbers, exact errors (file:line), indices, polygons of any size in linear time, continuations, CRLF, material
 // libraries and where they may live.
-#include "obj_reader.h"
+#include "import/obj_reader.h"
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>
@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "test_util.h"
-#include "vox/error.h"
-#include "vox/import.h"
+#include "vox/core/error.h"
+#include "vox/import/import.h"
 
 namespace vox {
 namespace {

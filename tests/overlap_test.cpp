@@ -7,8 +7,8 @@
 
 #include "adversary.h"
 #include "reference_overlap.h"
-#include "vox/grid.h"
-#include "vox/overlap.h"
+#include "vox/core/grid.h"
+#include "vox/voxelize/overlap.h"
 
 namespace vox {
 namespace {

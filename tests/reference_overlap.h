@@ -9,8 +9,8 @@
 #include <algorithm>
 #include <array>
 
-#include "vox/math.h"
-#include "vox/scene.h"
+#include "vox/core/math.h"
+#include "vox/core/scene.h"
 
 namespace vox::reference {
 

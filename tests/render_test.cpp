@@ -10,12 +10,12 @@
 #include <random>
 
 #include "test_util.h"
-#include "vox/accel.h"
-#include "vox/error.h"
-#include "vox/image_io.h"
-#include "vox/import.h"
-#include "vox/render.h"
-#include "vox/voxelize.h"
+#include "vox/trace/accel.h"
+#include "vox/core/error.h"
+#include "vox/io/image_io.h"
+#include "vox/import/import.h"
+#include "vox/trace/render.h"
+#include "vox/voxelize/voxelize.h"
 
 namespace vox {
 namespace {

@@ -8,7 +8,7 @@
 #include <random>
 #include <string>
 
-#include "vox/scene.h"
+#include "vox/core/scene.h"
 
 namespace vox::testing {
 

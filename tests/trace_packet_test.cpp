@@ -10,11 +10,11 @@
 
 #include "lattice_scene.h"
 #include "test_util.h"
-#include "vox/accel.h"
-#include "vox/error.h"
-#include "vox/render.h"
-#include "vox/trace_packet.h"
-#include "vox/voxelize.h"
+#include "vox/trace/accel.h"
+#include "vox/core/error.h"
+#include "vox/trace/render.h"
+#include "vox/trace/trace_packet.h"
+#include "vox/voxelize/voxelize.h"
 
 namespace vox {
 namespace {

@@ -11,10 +11,10 @@
 
 #include "lattice_scene.h"
 #include "test_util.h"
-#include "vox/accel.h"
-#include "vox/intersect.h"
-#include "vox/traverse.h"
-#include "vox/voxelize.h"
+#include "vox/trace/accel.h"
+#include "vox/trace/intersect.h"
+#include "vox/trace/traverse.h"
+#include "vox/voxelize/voxelize.h"
 
 namespace vox {
 namespace {

@@ -12,9 +12,9 @@
 #include <unordered_map>
 #include <unordered_set>
 
-#include "vox/colormap.h"
-#include "vox/error.h"
-#include "vox/voxel_mesh.h"
+#include "vox/export/colormap.h"
+#include "vox/core/error.h"
+#include "vox/export/voxel_mesh.h"
 
 namespace vox {
 namespace {

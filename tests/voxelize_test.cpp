@@ -7,10 +7,10 @@
 
 #include "reference_overlap.h"
 #include "test_util.h"
-#include "vox/error.h"
-#include "vox/import.h"
-#include "vox/overlap.h"
-#include "vox/voxelize.h"
+#include "vox/core/error.h"
+#include "vox/import/import.h"
+#include "vox/voxelize/overlap.h"
+#include "vox/voxelize/voxelize.h"
 
 namespace vox {
 namespace {

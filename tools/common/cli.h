@@ -9,7 +9,7 @@
 #include <optional>
 #include <string>
 
-#include "vox/tool.h"
+#include "vox/core/tool.h"
 
 namespace vox::cli {
 

@@ -5,11 +5,11 @@
 #include <filesystem>
 
 #include "../common/cli.h"
-#include "vox/atomic_file.h"
-#include "vox/error.h"
-#include "vox/grid_file.h"
-#include "vox/progress.h"
-#include "vox/voxel_mesh.h"
+#include "vox/io/atomic_file.h"
+#include "vox/core/error.h"
+#include "vox/io/grid_file.h"
+#include "vox/core/progress.h"
+#include "vox/export/voxel_mesh.h"
 
 namespace {
 

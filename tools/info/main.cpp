@@ -2,8 +2,8 @@
 #include <cstdio>
 
 #include "../common/cli.h"
-#include "vox/grid_file.h"
-#include "vox/info.h"
+#include "vox/io/grid_file.h"
+#include "vox/io/info.h"
 
 int main(int argc, char** argv) {
   std::string path;

@@ -5,13 +5,13 @@
 #include <filesystem>
 
 #include "../common/cli.h"
-#include "vox/atomic_file.h"
-#include "vox/accel.h"
-#include "vox/error.h"
-#include "vox/grid_file.h"
-#include "vox/image_io.h"
-#include "vox/progress.h"
-#include "vox/render.h"
+#include "vox/io/atomic_file.h"
+#include "vox/trace/accel.h"
+#include "vox/core/error.h"
+#include "vox/io/grid_file.h"
+#include "vox/io/image_io.h"
+#include "vox/core/progress.h"
+#include "vox/trace/render.h"
 
 namespace {
 

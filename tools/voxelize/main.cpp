@@ -5,14 +5,14 @@
 #include <chrono>
 
 #include "../common/cli.h"
-#include "vox/atomic_file.h"
-#include "vox/error.h"
-#include "vox/fill.h"
-#include "vox/grid_file.h"
-#include "vox/import.h"
-#include "vox/input_file.h"
-#include "vox/progress.h"
-#include "vox/voxelize.h"
+#include "vox/io/atomic_file.h"
+#include "vox/core/error.h"
+#include "vox/voxelize/fill.h"
+#include "vox/io/grid_file.h"
+#include "vox/import/import.h"
+#include "vox/io/input_file.h"
+#include "vox/core/progress.h"
+#include "vox/voxelize/voxelize.h"
 
 namespace {
 

@@ -1,0 +1,66 @@
+// The sparse uniform grid (DESIGN.md "Grid"). Cell (i,j,k) is the closed box between cellBoundary(a, i) and
+// cellBoundary(a, i+1) on each axis a; that one formula is used by voxelization, traversal and export alike.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "vox/core/math.h"
+
+namespace vox {
+
+enum class OverlapMethod : uint8_t { Center = 0, BBox = 1, Sat = 2, Exact = 3 };
+
+std::string methodName(OverlapMethod method);
+// Throws InputError for an unknown name.
+OverlapMethod parseMethod(const std::string& name);
+
+// Cells are stored sparsely in compressed-row form: cellKeys (sorted linear cell indices, key = i + nx*(j + ny*k))
+// and, for occupied cell c, the primitive ids primIds[cellStart[c] .. cellStart[c+1]), ascending.
+struct Grid {
+  Box bounds;
+  std::array<uint32_t, 3> dims{1, 1, 1};
+  OverlapMethod method = OverlapMethod::Exact;
+  std::vector<uint64_t> cellKeys;
+  std::vector<uint64_t> cellStart{0};
+  std::vector<uint32_t> primIds;
+  // Bounded primitives that stick out of user-given bounds: tracing tests them for every ray, like planes.
+  std::vector<uint32_t> outsidePrims;
+  // Cells inside closed surfaces (--fill), sorted keys; they hold no primitive.
+  std::vector<uint64_t> solidKeys;
+
+  uint64_t cellCount() const { return uint64_t(dims[0]) * dims[1] * dims[2]; }
+  size_t occupiedCount() const { return cellKeys.size(); }
+  size_t referenceCount() const { return primIds.size(); }
+  std::span<const uint32_t> cellPrims(size_t occupiedIndex) const {
+    return {primIds.data() + cellStart[occupiedIndex], primIds.data() + cellStart[occupiedIndex + 1]};
+  }
+};
+
+inline uint64_t cellKey(const std::array<uint32_t, 3>& dims, uint64_t i, uint64_t j, uint64_t k) {
+  return i + dims[0] * (j + uint64_t(dims[1]) * k);
+}
+inline std::array<uint32_t, 3> cellIndex(const std::array<uint32_t, 3>& dims, uint64_t key) {
+  return {uint32_t(key % dims[0]), uint32_t((key / dims[0]) % dims[1]), uint32_t(key / (uint64_t(dims[0]) * dims[1]))};
+}
+
+// b_a(i) = lo_a + (hi_a - lo_a) * i / n_a, in double precision, evaluated exactly in this order. i in [0, n_a].
+// Every grid libvox makes or reads satisfies b_a(0) == lo_a and b_a(n_a) == hi_a exactly (planGrid nudges hi by a few
+// ulps where needed; readGridFile refuses a file that breaks it), so the cells tile the bounds without a sliver.
+inline double cellBoundary(const Box& bounds, const std::array<uint32_t, 3>& dims, int axis, int64_t i) {
+  return bounds.lo[axis] + (bounds.hi[axis] - bounds.lo[axis]) * double(i) / double(dims[axis]);
+}
+Box cellBox(const Grid& grid, uint32_t i, uint32_t j, uint32_t k);
+
+// Index of the occupied cell with `key`, or -1. O(log occupied).
+int64_t findCell(const Grid& grid, uint64_t key);
+
+// Smallest index range [first, last] of cells on `axis` whose closed boxes meet [lo, hi] (clamped to the grid);
+// uses cellBoundary, so a coordinate exactly on a boundary yields both neighbouring cells. first > last when the
+// interval misses the grid.
+std::array<int64_t, 2> cellRange(const Box& bounds, const std::array<uint32_t, 3>& dims, int axis, double lo, double hi);
+
+}  // namespace vox

@@ -1,0 +1,40 @@
+// Scene importers. Each reads one file and returns a Scene in world space (DESIGN.md "Scene model").
+// All throw InputError with the file name and the place (line, node, accessor) on malformed input.
+#pragma once
+
+#include <string>
+
+#include "vox/core/scene.h"
+
+namespace vox {
+
+// Dispatches on the extension: .txt (course format), .obj, .gltf/.glb, .ply.
+Scene loadScene(const std::string& path);
+
+// The MIT 6.837 text scene format (grammar in seed-scenes/6837/README.md). TriangleMesh paths are resolved relative
+// to the scene file's folder. Procedural materials (Checkerboard, Noise, Marble, Wood) become their first
+// material's colour, with a warning.
+Scene importCourseScene(const std::string& path);
+// Wavefront OBJ, read by libvox's own reader in double precision (a coordinate comes back bit for bit from 17
+// significant digits): polygons of any size fan-triangulated, negative indices, line continuations. .mtl: Kd ->
+// diffuse, Ks -> specular, Ns -> exponent, Ni -> indexOfRefraction; faces without a material get a default white
+// one (the last material). `mtllib` files are resolved in the OBJ file's folder: a missing one is a warning, one
+// outside that folder or not a regular file an InputError. Throws InputError "file:line: ..." on a malformed
+// number (NaN, infinity, out of range), an index outside the vertices, or a file over 4 GiB.
+Scene importObj(const std::string& path);
+// glTF 2.0 (.gltf, .glb) through tinygltf: node hierarchy (matrix or TRS), triangle primitives (indexed or not),
+// baseColorFactor, cameras, KHR_lights_punctual. Other primitive modes are skipped with a warning.
+// Scene: the default scene, else scene 0, else every root node. Triangle strips and fans are converted.
+// Camera: the first camera node in depth-first order; yfov (radians) -> fovDegrees, orthographic ymag ->
+// orthoHeight = 2 * ymag; looks down the node's -Z with +Y up. Materials: baseColorFactor RGB -> diffuse; base
+// colour textures are not sampled (one warning). Lights: directional along the node's -Z, point at the node's
+// origin, spot -> point (warning). glTF intensities are physical (lux, candela) and a Phong shader has no exposure
+// to map them, so Light::color = color * min(intensity, 1) and point lights get no distance falloff (attenuation
+// 1 0 0). Accessor, bufferView and index ranges are checked: InputError "file: accessor N: ...".
+Scene importGltf(const std::string& path);
+// PLY triangle meshes (ASCII and binary), read by libvox itself: coordinates exact (double properties bit for bit),
+// faces fan-triangulated. Throws InputError naming the file and the line (ASCII) or element and byte (binary) on a
+// value that does not fit its declared type, a vertex index out of range, or an element count the file cannot hold.
+Scene importPly(const std::string& path);
+
+}  // namespace vox

@@ -1,0 +1,34 @@
+// The grid file (.vgrid): a scene and its grid in one self-contained, checksummed, little-endian binary file.
+// Layout in docs/grid-format.md.
+#pragma once
+
+#include <string>
+
+#include "vox/core/grid.h"
+#include "vox/core/scene.h"
+
+namespace vox {
+
+inline constexpr uint32_t kGridFileVersion = 1;
+
+struct GridFile {
+  Scene scene;
+  Grid grid;
+};
+
+// Writes to `path` through a temporary file in the same folder and a rename, so a failure leaves no partial file.
+// Throws OutputError naming the path.
+void writeGridFile(const std::string& path, const Scene& scene, const Grid& grid);
+
+// Reads and checks every count, offset, id and the checksum. Throws InputError naming the path and the byte offset
+// for a truncated, corrupt or newer-version file.
+GridFile readGridFile(const std::string& path);
+
+// The checksum of docs/grid-format.md over a payload (the bytes after the 32-byte header).
+uint64_t gridChecksum(const char* payload, size_t size);
+
+// The same on bytes in memory (fuzzing, tests). `name` is used in error messages.
+std::string encodeGridFile(const Scene& scene, const Grid& grid);
+GridFile decodeGridFile(const std::string& bytes, const std::string& name);
+
+}  // namespace vox

@@ -1,0 +1,96 @@
+// The trace-time acceleration structure built from a Grid: primitives prepared for fast tests, the primitives that
+// every ray must test (planes, Grid::outsidePrims), and an O(1) lookup of a cell's primitive list by (i,j,k).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "vox/core/grid.h"
+#include "vox/trace/intersect.h"
+#include "vox/core/scene.h"
+
+namespace vox {
+
+// `Grid` walks the cells; `None` tests every primitive for every ray (brute force, the reference for tests).
+enum class AccelKind : uint8_t { Grid, None };
+// Throws UsageError for a name other than "grid" or "none".
+AccelKind parseAccel(const std::string& name);
+
+// The cell boundaries of a grid as tables: b[a][i] == cellBoundary(bounds, dims, a, i) for i in [0, dims[a]], the
+// very same values computed once, so that the walker reads them instead of evaluating the formula (a division by n)
+// at every step. Also the per-axis constants the walker's tolerances need. World units.
+struct CellBoundaries {
+  std::array<uint32_t, 3> dims{0, 0, 0};
+  std::array<std::vector<double>, 3> b;
+  std::array<double, 3> cellsPerUnit{0, 0, 0};  // n / (b(n) - b(0)): a first guess of a cell index only
+  std::array<double, 3> cellSize{0, 0, 0};      // (b(n) - b(0)) / n
+  std::array<double, 3> magnitude{0, 0, 0};     // max(|b(0)|, |b(n)|)
+  double minCell = 0;                           // smallest positive cellSize, 0 when there is none
+};
+CellBoundaries makeCellBoundaries(const Box& bounds, const std::array<uint32_t, 3>& dims);
+
+inline constexpr uint32_t kEmptyCell = 0xffffffffu;
+inline constexpr uint32_t kSolidCell = 0xfffffffeu;
+
+struct Accel {
+  AccelKind kind = AccelKind::Grid;
+  const Grid* grid = nullptr;  // not owned: the Grid must outlive the Accel
+  uint32_t triangleCount = 0, sphereCount = 0, planeCount = 0;
+  std::vector<TriangleData> triangles;
+  std::vector<SphereData> spheres;
+  std::vector<Plane> planes;
+  // Planes and Grid::outsidePrims, ascending ids: tested for every ray, before the walk.
+  std::vector<uint32_t> alwaysTested;
+  // Boundary tables of the grid, for the walker.
+  CellBoundaries boundaries;
+
+  // Two-level lookup: the grid is cut into blocks of 2^blockShift cells a side; blockSlot holds, for each block,
+  // kEmptyCell or the index of its table in cellSlots (2^(3*blockShift) entries, x fastest), whose entries are the
+  // occupied-cell index into grid->cellStart, kSolidCell or kEmptyCell. blockShift == 0 means the grid was too big
+  // or too scattered for tables, and lookups fall back to a binary search in grid->cellKeys.
+  uint32_t blockShift = 0;
+  std::array<uint32_t, 3> blockDims{0, 0, 0};
+  std::vector<uint32_t> blockSlot;
+  std::vector<uint32_t> cellSlots;
+
+  uint32_t primitiveCount() const { return triangleCount + sphereCount + planeCount; }
+
+  // kEmptyCell, kSolidCell or the occupied-cell index of cell (i,j,k); indices must be inside the grid.
+  uint32_t lookup(uint32_t i, uint32_t j, uint32_t k) const {
+    if (blockShift != 0) {
+      const uint32_t s = blockShift;
+      const uint32_t b = blockSlot[(i >> s) + blockDims[0] * ((j >> s) + uint64_t(blockDims[1]) * (k >> s))];
+      if (b == kEmptyCell) return kEmptyCell;
+      const uint32_t m = (1u << s) - 1;
+      return cellSlots[(uint64_t(b) << (3 * s)) + ((i & m) | ((j & m) << s) | ((k & m) << (2 * s)))];
+    }
+    return lookupSlow(i, j, k);
+  }
+  uint32_t lookupSlow(uint32_t i, uint32_t j, uint32_t k) const;
+  // True when the whole block holding cell (i,j,k) is empty (always false without tables).
+  bool blockEmpty(uint32_t i, uint32_t j, uint32_t k) const {
+    if (blockShift == 0) return false;
+    const uint32_t s = blockShift;
+    return blockSlot[(i >> s) + blockDims[0] * ((j >> s) + uint64_t(blockDims[1]) * (k >> s))] == kEmptyCell;
+  }
+  std::span<const uint32_t> cellPrims(uint32_t occupiedIndex) const { return grid->cellPrims(occupiedIndex); }
+};
+
+// The ray test of primitive `id` (any kind), as every traversal calls it.
+inline bool intersectPrimitive(const Accel& accel, uint32_t id, const Ray& ray, double& t) {
+  if (id < accel.triangleCount) return intersectTriangle(accel.triangles[id], ray, t);
+  const uint32_t s = id - accel.triangleCount;
+  if (s < accel.sphereCount) return intersectSphere(accel.spheres[s], ray, t);
+  return intersectPlane(accel.planes[s - accel.sphereCount], ray, t);
+}
+
+// Prepares every primitive of `scene` and the cell lookup of `grid` (which must have been built from `scene`; the
+// Accel keeps a pointer to it). Throws InputError when the grid names primitive ids that
+// the scene does not have, vox::Error for a singular ellipsoid transform, LimitError when the grid has 2^32 - 2 or
+// more occupied cells.
+Accel buildAccel(const Scene& scene, const Grid& grid, AccelKind kind);
+
+}  // namespace vox

@@ -1,0 +1,65 @@
+// Rendering an image by tracing rays through an Accel (DESIGN.md "vox-trace"). No file I/O here (image_io.h).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "vox/trace/accel.h"
+#include "vox/trace/ray.h"
+#include "vox/core/scene.h"
+#include "vox/trace/traverse.h"
+
+namespace vox {
+
+enum class RenderMode : uint8_t { Shade, Voxels, Count, Normals, Depth };
+// Throws UsageError for a name other than shade, voxels, count, normals, depth.
+RenderMode parseRenderMode(const std::string& name);
+
+// A float image, rows from the top, pixels interleaved: pixels[(y * width + x) * channels + c].
+struct Image {
+  uint32_t width = 0, height = 0, channels = 3;
+  std::vector<float> pixels;
+
+  float* at(uint32_t x, uint32_t y) { return pixels.data() + (uint64_t(y) * width + x) * channels; }
+  const float* at(uint32_t x, uint32_t y) const { return pixels.data() + (uint64_t(y) * width + x) * channels; }
+};
+
+struct RenderOptions {
+  uint32_t width = 512, height = 512;
+  RenderMode mode = RenderMode::Shade;
+  uint32_t samples = 1;   // per pixel; > 1 jitters inside the pixel (stratified when a square number)
+  Camera camera;          // already resolved (scene camera, overrides or defaultCamera)
+  uint64_t seed = 0;      // of the per-pixel jitter
+  // Called from worker threads with the fraction of rows done; may be empty.
+  std::function<void(double)> progress;
+};
+
+struct RenderStats {
+  TraceStats trace;       // every ray: primary, shadow
+  double traceSeconds = 0;
+  double countMax = 0;    // count mode: cells visited of the busiest pixel (the top of the heat map)
+  double depthMin = 0, depthMax = 0;  // depth mode: range over hit pixels (0, 0 when nothing is hit)
+};
+
+// The primary ray through image position (px, py), in pixels from the top-left corner (pixel centres at +0.5),
+// by the camera convention of DESIGN.md: right = normalize(direction x up), trueUp = right x direction,
+// perspective rays from the centre through direction + u right + v trueUp (u, v from the vertical fov, v up),
+// orthographic rays parallel to direction from centre + u right + v trueUp (u, v from orthoHeight).
+// The direction of a perspective ray is not normalised. Throws UsageError for a degenerate camera.
+Ray primaryRay(const Camera& camera, uint32_t width, uint32_t height, double px, double py);
+
+// Renders `scene` (the scene of accel.grid) in options.mode. Output channels: shade, voxels, count, normals: RGB in
+// [0, 1] (linear, unclamped for shade); depth: one channel, the distance along the unit ray direction to the hit,
+// 0 where nothing is hit. Without lights the scene is lit by a headlight (a directional light along the camera
+// direction, casting no shadow). Throws UsageError for a zero size or sample count.
+Image traceImage(const Scene& scene, const Accel& accel, const RenderOptions& options, RenderStats* stats = nullptr);
+
+// The depth image as grey for 8-bit formats, linear in 1/depth: the nearest hit 1, the farthest 0.15, nothing hit 0.
+Image depthToGrey(const Image& depth);
+
+// Heat colour of value / maxValue in [0, 1] (dark blue, through red, to white) for the count mode.
+Vec3 heatColor(double value, double maxValue);
+
+}  // namespace vox

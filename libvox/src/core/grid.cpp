@@ -1,0 +1,49 @@
+#include "vox/core/grid.h"
+
+#include <algorithm>
+
+#include "voxelize/cell_range.h"
+#include "vox/core/error.h"
+
+namespace vox {
+
+std::string methodName(OverlapMethod method) {
+  switch (method) {
+    case OverlapMethod::Center: return "center";
+    case OverlapMethod::BBox: return "bbox";
+    case OverlapMethod::Sat: return "sat";
+    case OverlapMethod::Exact: return "exact";
+  }
+  return "unknown";
+}
+
+OverlapMethod parseMethod(const std::string& name) {
+  for (auto m : {OverlapMethod::Center, OverlapMethod::BBox, OverlapMethod::Sat, OverlapMethod::Exact})
+    if (methodName(m) == name) return m;
+  fail<InputError>("unknown overlap method '", name, "' (expected exact, sat, bbox or center)");
+}
+
+Box cellBox(const Grid& grid, uint32_t i, uint32_t j, uint32_t k) {
+  const uint32_t idx[3] = {i, j, k};
+  Box box;
+  for (int a = 0; a < 3; ++a) {
+    box.lo.at(a) = cellBoundary(grid.bounds, grid.dims, a, idx[a]);
+    box.hi.at(a) = cellBoundary(grid.bounds, grid.dims, a, int64_t(idx[a]) + 1);
+  }
+  return box;
+}
+
+int64_t findCell(const Grid& grid, uint64_t key) {
+  const auto it = std::lower_bound(grid.cellKeys.begin(), grid.cellKeys.end(), key);
+  if (it == grid.cellKeys.end() || *it != key) return -1;
+  return it - grid.cellKeys.begin();
+}
+
+std::array<int64_t, 2> cellRange(const Box& bounds, const std::array<uint32_t, 3>& dims, int axis, double lo,
+                                 double hi) {
+  const double scale = double(dims[axis]) / (bounds.hi[axis] - bounds.lo[axis]);
+  return cellRangeOnAxis(
+      dims[axis], scale, [&](int64_t c) { return cellBoundary(bounds, dims, axis, c); }, lo, hi);
+}
+
+}  // namespace vox

@@ -1,0 +1,425 @@
+// PLY triangle meshes (Turk's format: ascii, binary_little_endian, binary_big_endian 1.0), read here in one pass
+// over the file held in memory.
+// Why not OpenMesh's reader (9.0): it reads every point into a Vec3f, so a `double` property loses its low bits
+// (ASCII and binary alike), and it trusts its input (it loops forever on a header without `end_header`, grows a
+// vector until memory runs out on a corrupt list count, drops faces with an invalid index with a message on
+// std::cerr). Here:
+// - every value is checked against its declared type: an ASCII value that does not fit (`1e39` in a float, `300` in
+//   a uchar, `-1` in a uint) or is not a finite number is an InputError naming the line; binary coordinates must be
+//   finite;
+// - coordinates are kept as the file gives them: a `double` property bit for bit, a `float` one exactly as its
+//   float value, an ASCII number rounded once to the nearest double (DESIGN.md);
+// - each element count is checked against the bytes that remain before anything is allocated or walked: an ASCII
+//   value takes at least 2 bytes (digit and separator), a binary one its size; an element with no properties is
+//   allowed at most one per remaining byte (it holds no data; this bound only stops absurd counts);
+// - faces: the `vertex_indices` (or `vertex_index`) list, fan-triangulated; an index outside the vertices is an
+//   error; repeated indices give degenerate triangles, kept as DESIGN.md says; faces with fewer than 3 vertices
+//   are skipped with one warning. Other elements and properties are checked and skipped.
+#include <algorithm>
+#include <bit>
+#include <cfloat>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "import/obj_reader.h"
+#include "vox/core/error.h"
+#include "vox/import/import.h"
+
+namespace vox {
+namespace {
+
+// Larger files are refused before they are read.
+constexpr size_t kMaxPlyFileBytes = size_t{8} << 30;
+
+enum class PlyType : uint8_t { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64 };
+
+std::optional<PlyType> plyType(std::string_view t) {
+  if (t == "char" || t == "int8") return PlyType::Int8;
+  if (t == "uchar" || t == "uint8") return PlyType::UInt8;
+  if (t == "short" || t == "int16") return PlyType::Int16;
+  if (t == "ushort" || t == "uint16") return PlyType::UInt16;
+  if (t == "int" || t == "int32") return PlyType::Int32;
+  if (t == "uint" || t == "uint32") return PlyType::UInt32;
+  if (t == "float" || t == "float32") return PlyType::Float32;
+  if (t == "double" || t == "float64") return PlyType::Float64;
+  return std::nullopt;
+}
+
+const char* typeName(PlyType t) {
+  static const char* kNames[] = {"char", "uchar", "short", "ushort", "int", "uint", "float", "double"};
+  return kNames[static_cast<int>(t)];
+}
+
+size_t typeSize(PlyType t) {
+  static const size_t kSizes[] = {1, 1, 2, 2, 4, 4, 4, 8};
+  return kSizes[static_cast<int>(t)];
+}
+
+bool isFloatType(PlyType t) { return t == PlyType::Float32 || t == PlyType::Float64; }
+
+// The range of an integer type.
+void integerRange(PlyType t, long long& lo, long long& hi) {
+  const int bits = 8 * static_cast<int>(typeSize(t));
+  const bool isSigned = t == PlyType::Int8 || t == PlyType::Int16 || t == PlyType::Int32;
+  lo = isSigned ? -(1LL << (bits - 1)) : 0;
+  hi = isSigned ? (1LL << (bits - 1)) - 1 : (1LL << bits) - 1;
+}
+
+// What a property means to us.
+enum class Role : uint8_t { Skip, X, Y, Z, Indices };
+
+struct PlyProperty {
+  std::string name;
+  bool list = false;
+  PlyType countType = PlyType::UInt8;  // list only
+  PlyType valueType = PlyType::Float32;
+  Role role = Role::Skip;
+};
+
+struct PlyElement {
+  std::string name;
+  long long count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+struct PlyHeader {
+  std::string format;
+  std::vector<PlyElement> elements;
+  size_t bodyStart = 0;  // byte offset of the first byte after end_header's line
+  long long lines = 0;       // header lines, so that the body's first line is lines + 1
+};
+
+// Reads one header line's property into `e`; false when malformed.
+bool parseProperty(const std::vector<std::string>& w, PlyElement& e) {
+  PlyProperty p;
+  if (w.size() == 5 && w[1] == "list") {
+    const auto count = plyType(w[2]);
+    const auto value = plyType(w[3]);
+    if (!count || !value || isFloatType(*count)) return false;
+    p = {w[4], true, *count, *value, Role::Skip};
+  } else if (w.size() == 3) {
+    const auto value = plyType(w[1]);
+    if (!value) return false;
+    p = {w[2], false, PlyType::UInt8, *value, Role::Skip};
+  } else {
+    return false;
+  }
+  e.properties.push_back(p);
+  return true;
+}
+
+PlyHeader parseHeader(const std::string& data, const std::string& path) {
+  PlyHeader h;
+  size_t pos = 0;
+  for (;;) {
+    const size_t eol = data.find('\n', pos);
+    if (eol == std::string::npos) fail<InputError>(path, ": PLY header has no end_header line");
+    std::string line = data.substr(pos, eol - pos);
+    pos = eol + 1;
+    const long long lineNumber = ++h.lines;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::istringstream words(line);
+    std::vector<std::string> w;
+    for (std::string word; words >> word;) w.push_back(word);
+    auto bad = [&]() {
+      fail<InputError>(path, ":", lineNumber, ": malformed PLY header line ", quotedWord(line));
+    };
+    if (lineNumber == 1) {
+      if (w.size() != 1 || w[0] != "ply") fail<InputError>(path, ": not a PLY file (first line is not 'ply')");
+    } else if (lineNumber == 2) {
+      if (w.size() != 3 || w[0] != "format" || w[2] != "1.0" ||
+          (w[1] != "ascii" && w[1] != "binary_little_endian" && w[1] != "binary_big_endian"))
+        bad();
+      h.format = w[1];
+    } else if (w.empty() || w[0] == "comment" || w[0] == "obj_info") {
+      continue;
+    } else if (w[0] == "end_header") {
+      break;
+    } else if (w[0] == "element") {
+      if (w.size() != 3) bad();
+      PlyElement e{w[1], -1, {}};
+      const auto [end, ec] = std::from_chars(w[2].data(), w[2].data() + w[2].size(), e.count);
+      if (ec != std::errc() || end != w[2].data() + w[2].size() || e.count < 0) bad();
+      h.elements.push_back(e);
+    } else if (w[0] == "property") {
+      if (h.elements.empty() || !parseProperty(w, h.elements.back())) bad();
+    } else {
+      bad();
+    }
+  }
+  h.bodyStart = pos;
+  return h;
+}
+
+// Marks the properties we read (x, y, z of `vertex`, the index list of `face`) and checks they are usable.
+void assignRoles(PlyHeader& h, const std::string& path) {
+  bool haveVertex = false;
+  for (PlyElement& e : h.elements) {
+    if (e.name == "vertex") {
+      if (haveVertex) fail<InputError>(path, ": PLY header has two vertex elements");
+      haveVertex = true;
+      int found = 0;
+      for (PlyProperty& p : e.properties) {
+        if (p.list || p.name.size() != 1 || p.name[0] < 'x' || p.name[0] > 'z') continue;
+        p.role = p.name == "x" ? Role::X : (p.name == "y" ? Role::Y : Role::Z);
+        ++found;
+      }
+      if (found != 3) fail<InputError>(path, ": PLY vertex element needs exactly one each of x, y, z properties");
+    } else if (e.name == "face") {
+      for (PlyProperty& p : e.properties)
+        if (p.list && (p.name == "vertex_indices" || p.name == "vertex_index")) {
+          if (isFloatType(p.valueType))
+            fail<InputError>(path, ": PLY face property '", p.name, "' holds ", typeName(p.valueType), " values");
+          p.role = Role::Indices;
+        }
+    }
+  }
+  if (!haveVertex) fail<InputError>(path, ": PLY header has no vertex element");
+}
+
+// Refuses any element count the body cannot hold, before anything is allocated or walked.
+void checkCounts(const PlyHeader& h, size_t bodyBytes, const std::string& path) {
+  const bool ascii = h.format == "ascii";
+  // An ASCII value takes at least a character and a separator (the last one may lack its separator).
+  unsigned long long budget = ascii ? bodyBytes + 1 : bodyBytes;
+  for (const PlyElement& e : h.elements) {
+    unsigned long long least = 0;  // bytes per element at least
+    for (const PlyProperty& p : e.properties) least += ascii ? 2 : typeSize(p.list ? p.countType : p.valueType);
+    least = std::max(least, 1ULL);
+    const auto count = static_cast<unsigned long long>(e.count);
+    if (count > budget / least)
+      fail<InputError>(path, ": PLY element ", quotedWord(e.name), " declares ", e.count, " items, more than the ",
+                       bodyBytes, " bytes after the header can hold (truncated?)");
+    budget -= count * least;
+  }
+}
+
+struct PlyMesh {
+  std::vector<Vec3> vertices;
+  std::vector<std::array<uint32_t, 3>> triangles;
+  long long shortFaces = 0;  // faces with fewer than 3 vertices, skipped
+};
+
+// ASCII body: whitespace-separated tokens, each checked against its declared type.
+class AsciiCursor {
+ public:
+  AsciiCursor(const std::string& data, const PlyHeader& h, const std::string& path)
+      : data_(data), pos_(h.bodyStart), line_(h.lines + 1), path_(path) {}
+
+  void at(const PlyElement& e, long long i) {
+    element_ = &e;
+    index_ = i;
+  }
+  size_t remaining() const { return data_.size() - pos_; }
+  // The largest list length the rest of the file can hold: a separator and a character per value, whatever its type.
+  unsigned long long maxListLength(size_t /*valueBytes*/) const { return (remaining() + 1) / 2; }
+
+  double real(PlyType t) {
+    const std::string_view token = next();
+    if (!isFloatType(t)) return static_cast<double>(integer(t, token));
+    std::string_view s = token;
+    if (!s.empty() && s[0] == '+') s.remove_prefix(1);
+    double v = 0;
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (s.empty() || s[0] == '+' || ec != std::errc() || end != s.data() + s.size() || !std::isfinite(v))
+      failHere("bad number ", quotedWord(token));
+    if (t == PlyType::Float32 && std::fabs(v) > FLT_MAX)
+      failHere("value ", token, " does not fit in a float property");
+    return v;
+  }
+
+  // `t` is an integer type (list counts and indices: parseHeader and assignRoles see to it).
+  long long integer(PlyType t) { return integer(t, next()); }
+
+  template <typename... Parts>
+  [[noreturn]] void failHere(const Parts&... parts) const {
+    fail<InputError>(path_, ":", tokenLine_, ": ", element_->name, " ", index_, ": ", parts...);
+  }
+
+ private:
+  std::string_view next() {
+    while (pos_ < data_.size() && std::isspace(static_cast<unsigned char>(data_[pos_]))) {
+      if (data_[pos_] == '\n') ++line_;
+      ++pos_;
+    }
+    if (pos_ >= data_.size())
+      fail<InputError>(path_, ": PLY file ends inside ", element_->name, " ", index_, " (truncated?)");
+    const size_t start = pos_;
+    while (pos_ < data_.size() && !std::isspace(static_cast<unsigned char>(data_[pos_]))) ++pos_;
+    tokenLine_ = line_;
+    return std::string_view(data_).substr(start, pos_ - start);
+  }
+
+  long long integer(PlyType t, std::string_view token) const {
+    std::string_view s = token;
+    if (!s.empty() && s[0] == '+') s.remove_prefix(1);
+    long long v = 0;
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    const bool tooLarge = ec == std::errc::result_out_of_range;
+    if (s.empty() || s[0] == '+' || end != s.data() + s.size() || (ec != std::errc() && !tooLarge))
+      failHere("bad ", typeName(t), " value ", quotedWord(token));
+    long long lo = 0, hi = 0;
+    integerRange(t, lo, hi);
+    if (tooLarge || v < lo || v > hi)
+      failHere("value ", token, " does not fit in a ", typeName(t), " property");
+    return v;
+  }
+
+  const std::string& data_;
+  size_t pos_;
+  long long line_;
+  long long tokenLine_ = 0;
+  const std::string& path_;
+  const PlyElement* element_ = nullptr;
+  long long index_ = 0;
+};
+
+// Binary body: values in the file's byte order; bounds are checked before every read.
+class BinaryCursor {
+ public:
+  BinaryCursor(const std::string& data, const PlyHeader& h, const std::string& path)
+      : bytes_(reinterpret_cast<const unsigned char*>(data.data())),
+        size_(data.size()),
+        pos_(h.bodyStart),
+        bigEndian_(h.format == "binary_big_endian"),
+        path_(path) {}
+
+  void at(const PlyElement& e, long long i) {
+    element_ = &e;
+    index_ = i;
+    start_ = pos_;
+  }
+  size_t remaining() const { return size_ - pos_; }
+  unsigned long long maxListLength(size_t valueBytes) const { return remaining() / valueBytes; }
+
+  double real(PlyType t) {
+    const uint64_t u = raw(t);
+    if (t == PlyType::Float64) return std::bit_cast<double>(u);
+    if (t == PlyType::Float32) return static_cast<double>(std::bit_cast<float>(static_cast<uint32_t>(u)));
+    return static_cast<double>(toInteger(t, u));
+  }
+  long long integer(PlyType t) { return toInteger(t, raw(t)); }
+
+  template <typename... Parts>
+  [[noreturn]] void failHere(const Parts&... parts) const {
+    fail<InputError>(path_, ": ", element_->name, " ", index_, " (at byte ", start_, "): ", parts...);
+  }
+
+ private:
+  uint64_t raw(PlyType t) {
+    const size_t n = typeSize(t);
+    if (size_ - pos_ < n)
+      fail<InputError>(path_, ": PLY file ends inside ", element_->name, " ", index_, " (truncated?)");
+    uint64_t u = 0;
+    for (size_t i = 0; i < n; ++i) u |= static_cast<uint64_t>(bytes_[pos_ + (bigEndian_ ? n - 1 - i : i)]) << (8 * i);
+    pos_ += n;
+    return u;
+  }
+  static long long toInteger(PlyType t, uint64_t u) {
+    const size_t n = typeSize(t);
+    const bool isSigned = t == PlyType::Int8 || t == PlyType::Int16 || t == PlyType::Int32;
+    if (isSigned && ((u >> (8 * n - 1)) & 1)) return static_cast<long long>(u) - (1LL << (8 * n));
+    return static_cast<long long>(u);
+  }
+
+  const unsigned char* bytes_;
+  size_t size_;
+  size_t pos_;
+  bool bigEndian_;
+  const std::string& path_;
+  const PlyElement* element_ = nullptr;
+  long long index_ = 0;
+  size_t start_ = 0;
+};
+
+// Reads one face's index list and appends its fan of triangles.
+template <typename Cursor>
+void readFace(Cursor& in, const PlyProperty& p, long long n, size_t vertexCount, std::vector<uint32_t>& polygon,
+              PlyMesh& out) {
+  polygon.clear();
+  for (long long k = 0; k < n; ++k) {
+    const long long v = in.integer(p.valueType);
+    if (v < 0 || static_cast<unsigned long long>(v) >= vertexCount)
+      in.failHere("vertex index ", v, " out of range (", vertexCount, " vertices)");
+    polygon.push_back(static_cast<uint32_t>(v));
+  }
+  if (polygon.size() < 3) {
+    ++out.shortFaces;
+    return;
+  }
+  for (size_t k = 1; k + 1 < polygon.size(); ++k) out.triangles.push_back({polygon[0], polygon[k], polygon[k + 1]});
+}
+
+template <typename Cursor>
+void readElement(Cursor& in, const PlyElement& e, size_t vertexCount, PlyMesh& out) {
+  if (e.properties.empty()) return;  // holds no data; its count was bounded by checkCounts
+  std::vector<uint32_t> polygon;
+  const bool isVertex = e.name == "vertex";
+  for (long long i = 0; i < e.count; ++i) {
+    in.at(e, i);
+    double xyz[3] = {0, 0, 0};
+    for (const PlyProperty& p : e.properties) {
+      if (!p.list) {
+        const double v = in.real(p.valueType);
+        if (p.role == Role::Skip) continue;
+        if (!std::isfinite(v)) in.failHere("coordinate ", p.name, " is NaN or infinite");
+        xyz[static_cast<int>(p.role) - static_cast<int>(Role::X)] = v;
+        continue;
+      }
+      const long long n = in.integer(p.countType);
+      const size_t valueBytes = typeSize(p.valueType);
+      if (n < 0 || static_cast<unsigned long long>(n) > in.maxListLength(valueBytes))
+        in.failHere("bad list length ", n);
+      if (p.role == Role::Indices) {
+        readFace(in, p, n, vertexCount, polygon, out);
+      } else {
+        for (long long k = 0; k < n; ++k) in.real(p.valueType);
+      }
+    }
+    if (isVertex) out.vertices.push_back({xyz[0], xyz[1], xyz[2]});
+  }
+}
+
+template <typename Cursor>
+PlyMesh readBody(Cursor in, const PlyHeader& h) {
+  PlyMesh out;
+  size_t vertexCount = 0;
+  for (const PlyElement& e : h.elements) {
+    if (e.name == "vertex") vertexCount = static_cast<size_t>(e.count);
+    if (e.name == "face") out.triangles.reserve(static_cast<size_t>(e.count));
+  }
+  out.vertices.reserve(vertexCount);
+  for (const PlyElement& e : h.elements) readElement(in, e, vertexCount, out);
+  return out;
+}
+
+}  // namespace
+
+Scene importPly(const std::string& path) {
+  const std::string data = readTextFile(path, "PLY file", kMaxPlyFileBytes);
+  PlyHeader header = parseHeader(data, path);
+  checkCounts(header, data.size() - header.bodyStart, path);
+  assignRoles(header, path);
+  const PlyMesh mesh = header.format == "ascii" ? readBody(AsciiCursor(data, header, path), header)
+                                                : readBody(BinaryCursor(data, header, path), header);
+
+  Scene scene;
+  scene.materials.push_back(Material{"default"});
+  scene.triangles.reserve(mesh.triangles.size());
+  for (const auto& f : mesh.triangles)
+    scene.triangles.push_back({{mesh.vertices[f[0]], mesh.vertices[f[1]], mesh.vertices[f[2]]}, 0});
+  if (mesh.shortFaces > 0)
+    scene.warnings.push_back(path + ": " + std::to_string(mesh.shortFaces) +
+                             " faces with fewer than 3 vertices skipped");
+  return scene;
+}
+
+}  // namespace vox

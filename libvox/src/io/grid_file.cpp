@@ -1,0 +1,367 @@
+// Grid file encoding (docs/grid-format.md). Every read goes through ByteReader, which checks the remaining length
+// before touching memory, so a truncated or corrupt file can only ever throw.
+#include "vox/io/grid_file.h"
+
+#include <bit>
+#include <cstring>
+#include <limits>
+
+#include "vox/io/atomic_file.h"
+#include "vox/core/error.h"
+#include "vox/io/input_file.h"
+
+static_assert(std::endian::native == std::endian::little, "grid files are little-endian; big-endian hosts need byte swaps");
+
+namespace vox {
+
+namespace {
+
+constexpr char kMagic[8] = {'V', 'O', 'X', 'G', 'R', 'I', 'D', '\n'};
+constexpr size_t kHeaderSize = 32;  // magic, version, flags, payload size, checksum
+
+// 64-bit multiplicative hash over 8-byte words: any change of one word changes the result (xor then multiply by an
+// odd constant are bijections), and it runs at memory speed.
+uint64_t wordChecksum(const char* data, size_t size) {
+  uint64_t h = 0x9E3779B97F4A7C15ull ^ size;
+  size_t i = 0;
+  for (; i + 8 <= size; i += 8) {
+    uint64_t w;
+    std::memcpy(&w, data + i, 8);
+    h = (h ^ w) * 0x100000001B3ull;
+    h ^= h >> 29;
+  }
+  uint64_t tail = 0;
+  std::memcpy(&tail, data + i, size - i);
+  h = (h ^ tail) * 0x100000001B3ull;
+  return h ^ (h >> 32);
+}
+
+class ByteWriter {
+ public:
+  template <typename T>
+  void put(const T& value) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    const char* p = reinterpret_cast<const char*>(&value);
+    out_.append(p, sizeof(T));
+  }
+  void putVec(const Vec3& v) {
+    put(v.x);
+    put(v.y);
+    put(v.z);
+  }
+  void putString(const std::string& s) {
+    put(uint32_t(s.size()));
+    out_.append(s);
+  }
+  template <typename T>
+  void putArray(const std::vector<T>& values) {
+    put(uint64_t(values.size()));
+    out_.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+  }
+  std::string& bytes() { return out_; }
+
+ private:
+  std::string out_;
+};
+
+class ByteReader {
+ public:
+  ByteReader(const std::string& bytes, size_t offset, const std::string& name)
+      : data_(bytes), pos_(offset), name_(name) {}
+
+  [[noreturn]] void corrupt(const std::string& what) const { fail<InputError>(name_, ": byte ", pos_, ": ", what); }
+
+  void need(uint64_t n) const {
+    if (n > data_.size() - pos_) fail<InputError>(name_, ": truncated at byte ", data_.size(), " (needed ", n, " more bytes at byte ", pos_, ")");
+  }
+  template <typename T>
+  T get() {
+    need(sizeof(T));
+    T value;
+    std::memcpy(&value, data_.data() + pos_, sizeof(T));
+    pos_ += sizeof(T);
+    return value;
+  }
+  double getFinite(const char* what) {
+    const double v = get<double>();
+    if (!std::isfinite(v)) corrupt(std::string(what) + " is not a finite number");
+    return v;
+  }
+  Vec3 getVec(const char* what) {
+    Vec3 v;
+    v.x = getFinite(what);
+    v.y = getFinite(what);
+    v.z = getFinite(what);
+    return v;
+  }
+  std::string getString() {
+    const uint32_t n = get<uint32_t>();
+    need(n);
+    std::string s = data_.substr(pos_, n);
+    pos_ += n;
+    return s;
+  }
+  // A count of elements of `elementSize` bytes each that must fit in the rest of the file: refuses absurd counts
+  // before anything is allocated.
+  uint64_t getCount(size_t elementSize, const char* what) {
+    const uint64_t n = get<uint64_t>();
+    if (n > (data_.size() - pos_) / elementSize) corrupt(std::string(what) + " count " + std::to_string(n) + " exceeds the file");
+    return n;
+  }
+  template <typename T>
+  std::vector<T> getArray(const char* what) {
+    const uint64_t n = getCount(sizeof(T), what);
+    std::vector<T> values(n);
+    if (n > 0) std::memcpy(values.data(), data_.data() + pos_, n * sizeof(T));  // data() may be null when empty
+    pos_ += n * sizeof(T);
+    return values;
+  }
+  size_t position() const { return pos_; }
+  bool atEnd() const { return pos_ == data_.size(); }
+
+ private:
+  const std::string& data_;
+  size_t pos_;
+  const std::string& name_;
+};
+
+void putMaterial(ByteWriter& w, const Material& m) {
+  w.putString(m.name);
+  w.putVec(m.diffuse);
+  w.putVec(m.specular);
+  w.put(m.exponent);
+  w.putVec(m.reflective);
+  w.putVec(m.transparent);
+  w.put(m.indexOfRefraction);
+}
+
+Material getMaterial(ByteReader& r) {
+  Material m;
+  m.name = r.getString();
+  m.diffuse = r.getVec("material colour");
+  m.specular = r.getVec("material colour");
+  m.exponent = r.getFinite("material exponent");
+  m.reflective = r.getVec("material colour");
+  m.transparent = r.getVec("material colour");
+  m.indexOfRefraction = r.getFinite("material index of refraction");
+  return m;
+}
+
+}  // namespace
+
+uint64_t gridChecksum(const char* payload, size_t size) { return wordChecksum(payload, size); }
+
+std::string encodeGridFile(const Scene& scene, const Grid& grid) {
+  ByteWriter w;
+  // The header is filled in last, in place, so the (possibly large) payload is never copied.
+  w.bytes().reserve(kHeaderSize + 256 + scene.triangles.size() * 76 + grid.cellKeys.size() * 16 + grid.primIds.size() * 4 +
+                    scene.materials.size() * 128);
+  w.bytes().assign(kHeaderSize, '\0');
+  // Scene.
+  w.put(uint64_t(scene.materials.size()));
+  for (const auto& m : scene.materials) putMaterial(w, m);
+  w.put(uint64_t(scene.triangles.size()));
+  for (const auto& t : scene.triangles) {
+    for (const auto& v : t.v) w.putVec(v);
+    w.put(t.material);
+  }
+  w.put(uint64_t(scene.spheres.size()));
+  for (const auto& s : scene.spheres) {
+    w.putVec(s.center);
+    w.put(s.radius);
+    for (const auto& row : s.transform.m)
+      for (double x : row) w.put(x);
+    w.put(s.material);
+  }
+  w.put(uint64_t(scene.planes.size()));
+  for (const auto& p : scene.planes) {
+    w.putVec(p.normal);
+    w.put(p.offset);
+    w.put(p.material);
+  }
+  w.put(uint8_t(scene.camera.has_value()));
+  if (scene.camera) {
+    const Camera& c = *scene.camera;
+    w.put(uint8_t(c.kind));
+    w.putVec(c.center);
+    w.putVec(c.direction);
+    w.putVec(c.up);
+    w.put(c.fovDegrees);
+    w.put(c.orthoHeight);
+  }
+  w.put(uint64_t(scene.lights.size()));
+  for (const auto& l : scene.lights) {
+    w.put(uint8_t(l.kind));
+    w.putVec(l.direction);
+    w.putVec(l.position);
+    w.putVec(l.color);
+    w.putVec(l.attenuation);
+  }
+  w.putVec(scene.background);
+  w.putVec(scene.ambient);
+  // Grid.
+  w.putVec(grid.bounds.lo);
+  w.putVec(grid.bounds.hi);
+  for (uint32_t n : grid.dims) w.put(n);
+  w.put(uint8_t(grid.method));
+  w.putArray(grid.cellKeys);
+  w.putArray(grid.cellStart);
+  w.putArray(grid.primIds);
+  w.putArray(grid.outsidePrims);
+  w.putArray(grid.solidKeys);
+
+  std::string bytes = std::move(w.bytes());
+  const uint64_t payloadSize = bytes.size() - kHeaderSize;
+  const uint64_t sum = wordChecksum(bytes.data() + kHeaderSize, payloadSize);
+  const uint32_t version = kGridFileVersion, flags = 0;
+  std::memcpy(bytes.data(), kMagic, 8);
+  std::memcpy(bytes.data() + 8, &version, 4);
+  std::memcpy(bytes.data() + 12, &flags, 4);
+  std::memcpy(bytes.data() + 16, &payloadSize, 8);
+  std::memcpy(bytes.data() + 24, &sum, 8);
+  return bytes;
+}
+
+GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
+  if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0)
+    fail<InputError>(name, ": not a libvox grid file (bad magic number)");
+  ByteReader header(bytes, 8, name);
+  const uint32_t version = header.get<uint32_t>();
+  if (version > kGridFileVersion)
+    fail<InputError>(name, ": grid file version ", version, " is newer than this build reads (", kGridFileVersion, ")");
+  if (version == 0) fail<InputError>(name, ": byte 8: invalid grid file version 0");
+  if (header.get<uint32_t>() != 0) fail<InputError>(name, ": byte 12: unknown flags (written by a newer version?)");
+  const uint64_t payloadSize = header.get<uint64_t>();
+  const uint64_t expected = header.get<uint64_t>();
+  if (payloadSize != bytes.size() - kHeaderSize) {
+    if (payloadSize > bytes.size() - kHeaderSize)
+      fail<InputError>(name, ": truncated at byte ", bytes.size(), " (header promises ", payloadSize + kHeaderSize, " bytes)");
+    fail<InputError>(name, ": ", bytes.size() - kHeaderSize - payloadSize, " unexpected bytes after the end of the grid");
+  }
+  if (wordChecksum(bytes.data() + kHeaderSize, payloadSize) != expected)
+    fail<InputError>(name, ": checksum mismatch: the file is corrupt");
+
+  ByteReader r(bytes, kHeaderSize, name);
+  GridFile out;
+  Scene& scene = out.scene;
+  const uint64_t nMaterials = r.getCount(4 + 14 * 8, "material");
+  for (uint64_t i = 0; i < nMaterials; ++i) scene.materials.push_back(getMaterial(r));
+  auto material = [&](uint32_t m) {
+    if (m >= nMaterials) r.corrupt("material index " + std::to_string(m) + " out of range");
+    return m;
+  };
+  const uint64_t nTri = r.getCount(9 * 8 + 4, "triangle");
+  scene.triangles.resize(nTri);
+  for (auto& t : scene.triangles) {
+    for (auto& v : t.v) v = r.getVec("vertex");
+    t.material = material(r.get<uint32_t>());
+  }
+  const uint64_t nSph = r.getCount(20 * 8 + 4, "sphere");
+  scene.spheres.resize(nSph);
+  for (auto& s : scene.spheres) {
+    s.center = r.getVec("sphere centre");
+    s.radius = r.getFinite("sphere radius");
+    if (!(s.radius > 0)) r.corrupt("sphere radius is not positive");
+    for (auto& row : s.transform.m)
+      for (double& x : row) x = r.getFinite("sphere transform");
+    s.material = material(r.get<uint32_t>());
+  }
+  const uint64_t nPlane = r.getCount(4 * 8 + 4, "plane");
+  scene.planes.resize(nPlane);
+  for (auto& p : scene.planes) {
+    p.normal = r.getVec("plane normal");
+    p.offset = r.getFinite("plane offset");
+    p.material = material(r.get<uint32_t>());
+  }
+  const uint8_t hasCamera = r.get<uint8_t>();
+  if (hasCamera > 1) r.corrupt("invalid camera flag");
+  if (hasCamera) {
+    Camera c;
+    const uint8_t kind = r.get<uint8_t>();
+    if (kind > 1) r.corrupt("unknown camera kind " + std::to_string(kind));
+    c.kind = CameraKind(kind);
+    c.center = r.getVec("camera");
+    c.direction = r.getVec("camera");
+    c.up = r.getVec("camera");
+    c.fovDegrees = r.getFinite("camera field of view");
+    c.orthoHeight = r.getFinite("camera size");
+    scene.camera = c;
+  }
+  const uint64_t nLights = r.getCount(1 + 12 * 8, "light");
+  scene.lights.resize(nLights);
+  for (auto& l : scene.lights) {
+    const uint8_t kind = r.get<uint8_t>();
+    if (kind > 1) r.corrupt("unknown light kind " + std::to_string(kind));
+    l.kind = LightKind(kind);
+    l.direction = r.getVec("light");
+    l.position = r.getVec("light");
+    l.color = r.getVec("light");
+    l.attenuation = r.getVec("light");
+  }
+  scene.background = r.getVec("background");
+  scene.ambient = r.getVec("ambient");
+
+  Grid& grid = out.grid;
+  grid.bounds.lo = r.getVec("bounds");
+  grid.bounds.hi = r.getVec("bounds");
+  for (int a = 0; a < 3; ++a)
+    if (!(grid.bounds.lo[a] < grid.bounds.hi[a])) r.corrupt("empty grid bounds");
+  for (auto& n : grid.dims) {
+    n = r.get<uint32_t>();
+    if (n == 0 || n > (1u << 21)) r.corrupt("grid dimension " + std::to_string(n) + " out of range");
+  }
+  for (int a = 0; a < 3; ++a)
+    if (cellBoundary(grid.bounds, grid.dims, a, grid.dims[a]) != grid.bounds.hi[a])
+      r.corrupt("grid bounds do not match the cell boundary formula");
+  const uint8_t method = r.get<uint8_t>();
+  if (method > uint8_t(OverlapMethod::Exact)) r.corrupt("unknown overlap method " + std::to_string(method));
+  grid.method = OverlapMethod(method);
+
+  const size_t cellsAt = r.position();
+  grid.cellKeys = r.getArray<uint64_t>("cell");
+  grid.cellStart = r.getArray<uint64_t>("cell start");
+  grid.primIds = r.getArray<uint32_t>("reference");
+  grid.outsidePrims = r.getArray<uint32_t>("outside primitive");
+  grid.solidKeys = r.getArray<uint64_t>("solid cell");
+  if (!r.atEnd()) r.corrupt("unexpected bytes after the solid cells");
+
+  // Structural checks: sorted unique keys inside the grid, offsets that partition the references, ids in range.
+  auto bad = [&](const std::string& what) { fail<InputError>(name, ": cell table at byte ", cellsAt, ": ", what); };
+  const uint64_t cells = grid.cellCount();
+  const uint64_t bounded = nTri + nSph;
+  for (size_t c = 0; c < grid.cellKeys.size(); ++c)
+    if (grid.cellKeys[c] >= cells || (c > 0 && grid.cellKeys[c] <= grid.cellKeys[c - 1]))
+      bad("cell keys not sorted or outside the grid");
+  if (grid.cellStart.size() != grid.cellKeys.size() + 1) bad("cell offsets do not match the cell count");
+  if (grid.cellStart.front() != 0 || grid.cellStart.back() != grid.primIds.size()) bad("cell offsets do not cover the references");
+  // Every offset is checked before any primitive range is walked: offsets that run backwards or past the
+  // references would otherwise send the walk outside primIds.
+  for (size_t c = 0; c + 1 < grid.cellStart.size(); ++c)
+    if (grid.cellStart[c + 1] <= grid.cellStart[c] || grid.cellStart[c + 1] > grid.primIds.size())
+      bad("cell " + std::to_string(c) + ": offsets empty, backwards or past the references");
+  for (size_t c = 0; c + 1 < grid.cellStart.size(); ++c) {
+    for (uint64_t k = grid.cellStart[c]; k < grid.cellStart[c + 1]; ++k)
+      if (grid.primIds[k] >= bounded || (k > grid.cellStart[c] && grid.primIds[k] <= grid.primIds[k - 1]))
+        bad("primitive ids not ascending or out of range");
+  }
+  for (uint32_t id : grid.outsidePrims)
+    if (id >= bounded) bad("outside primitive id out of range");
+  for (size_t c = 0; c < grid.solidKeys.size(); ++c)
+    if (grid.solidKeys[c] >= cells || (c > 0 && grid.solidKeys[c] <= grid.solidKeys[c - 1])) bad("solid cells not sorted");
+  // The same checks as at import (singular ellipsoid transforms, cameras that cannot form an image, materials),
+  // so a grid file that passes here traces and exports.
+  validateScene(scene, name);
+  return out;
+}
+
+void writeGridFile(const std::string& path, const Scene& scene, const Grid& grid) {
+  const std::string bytes = encodeGridFile(scene, grid);
+  writeFileAtomically(path, bytes);
+}
+
+GridFile readGridFile(const std::string& path) {
+  // readInputFile refuses non-regular files and sizes the memory budget cannot hold, before reading them whole.
+  return decodeGridFile(readInputFile(path, "grid file"), path);
+}
+
+}  // namespace vox

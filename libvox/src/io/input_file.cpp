@@ -1,0 +1,111 @@
+#include "vox/io/input_file.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+
+#include "vox/core/error.h"
+
+namespace vox {
+
+uint64_t memoryBudgetBytes() {
+  if (const char* env = std::getenv("VOX_MEMORY_LIMIT_MB")) {
+    char* end = nullptr;
+    const unsigned long long mb = std::strtoull(env, &end, 10);
+    if (end != env && *end == '\0' && mb > 0 && mb < (1ull << 40)) return mb << 20;
+  }
+  const long pages = ::sysconf(_SC_PHYS_PAGES), size = ::sysconf(_SC_PAGE_SIZE);
+  const uint64_t physical = pages > 0 && size > 0 ? uint64_t(pages) * uint64_t(size) : (16ull << 30);
+  return physical / 4 * 3;  // a quarter stays for the rest of the system
+}
+
+void checkMemory(double bytes, const std::string& where, const std::string& what) {
+  const uint64_t budget = memoryBudgetBytes();
+  if (!(bytes <= double(budget)))
+    fail<LimitError>(where, ": ", what, " needs about ", std::isfinite(bytes) ? uint64_t(bytes / (1 << 20)) : UINT64_MAX,
+                     " MiB, more than the ", budget >> 20, " MiB allowed");
+}
+
+void requireRegularFile(const std::string& path, const char* what) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) fail<InputError>(path, ": cannot open ", what, ": ", std::strerror(errno));
+  if (S_ISDIR(st.st_mode)) fail<InputError>(path, ": is a folder, expected the ", what);
+  if (!S_ISREG(st.st_mode)) fail<InputError>(path, ": not a regular file (a device, FIFO or socket), expected the ", what);
+}
+
+std::string readInputFile(const std::string& path, const char* what) {
+  requireRegularFile(path, what);
+  // Opened once and checked again through the descriptor, so a file swapped after the check is still a regular
+  // file of known size when read.
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (!file) fail<InputError>(path, ": cannot open ", what, ": ", std::strerror(errno));
+  struct stat st {};
+  if (::fstat(::fileno(file), &st) != 0 || !S_ISREG(st.st_mode)) {
+    std::fclose(file);
+    fail<InputError>(path, ": not a regular file, not a ", what);
+  }
+  try {
+    checkMemory(2.0 * double(st.st_size), path, std::string("reading this ") + what);
+  } catch (...) {
+    std::fclose(file);
+    throw;
+  }
+  std::string bytes(size_t(st.st_size), '\0');
+  const size_t got = bytes.empty() ? 0 : std::fread(bytes.data(), 1, bytes.size(), file);
+  const bool error = std::ferror(file) != 0;
+  std::fclose(file);
+  if (error || got != bytes.size()) fail<InputError>(path, ": read error after ", got, " bytes");
+  return bytes;
+}
+
+std::string resolveInsideFolder(const std::string& referrer, const std::string& reference) {
+  namespace fs = std::filesystem;
+  const fs::path ref(reference);
+  if (ref.is_absolute() || ref.has_root_name())
+    fail<InputError>(referrer, ": '", quoteInput(reference), "': absolute paths are refused (files must lie in the "
+                     "folder of the file that names them)");
+  return requireInsideFolder(referrer, (fs::absolute(referrer).parent_path() / ref).string());
+}
+
+std::string requireInsideFolder(const std::string& referrer, const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  // Canonical forms resolve "..", "." and symbolic links, so neither can lead out.
+  const fs::path folder = fs::weakly_canonical(fs::absolute(referrer).parent_path(), ec);
+  const fs::path target = ec ? fs::path() : fs::weakly_canonical(fs::absolute(path), ec);
+  if (ec) fail<InputError>(referrer, ": '", quoteInput(path), "': cannot resolve: ", ec.message());
+  // Component by component: "/a/bc" is not inside "/a/b".
+  auto t = target.begin();
+  for (auto f = folder.begin(); f != folder.end(); ++f, ++t)
+    if (t == target.end() || *f != *t)
+      fail<InputError>(referrer, ": '", quoteInput(path, 80), "': lies outside the folder of ", referrer);
+  return target.string();
+}
+
+std::string quoteInput(const std::string& text, size_t maxBytes) {
+  std::string out;
+  for (size_t i = 0; i < text.size(); ++i) {
+    if (out.size() >= maxBytes) {
+      out += "...";
+      break;
+    }
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    // Bytes of 0x80 and above pass: they are UTF-8 in file names and text users wrote.
+    if (c >= 0x20 && c != 0x7f) {
+      out += char(c);
+    } else {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02x", c);
+      out += hex;
+    }
+  }
+  return out;
+}
+
+}  // namespace vox

@@ -1,0 +1,128 @@
+#include "vox/trace/accel.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "vox/core/error.h"
+
+namespace vox {
+
+AccelKind parseAccel(const std::string& name) {
+  if (name == "grid") return AccelKind::Grid;
+  if (name == "none") return AccelKind::None;
+  fail<UsageError>("unknown acceleration '", name, "' (expected grid or none)");
+}
+
+uint32_t Accel::lookupSlow(uint32_t i, uint32_t j, uint32_t k) const {
+  const uint64_t key = cellKey(grid->dims, i, j, k);
+  const int64_t c = findCell(*grid, key);
+  if (c >= 0) return uint32_t(c);
+  if (std::binary_search(grid->solidKeys.begin(), grid->solidKeys.end(), key)) return kSolidCell;
+  return kEmptyCell;
+}
+
+CellBoundaries makeCellBoundaries(const Box& bounds, const std::array<uint32_t, 3>& dims) {
+  CellBoundaries cb;
+  cb.dims = dims;
+  double minCell = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    cb.b[a].resize(size_t(dims[a]) + 1);
+    for (int64_t i = 0; i <= int64_t(dims[a]); ++i) cb.b[a][size_t(i)] = cellBoundary(bounds, dims, a, i);
+    const double lo = cb.b[a].front(), hi = cb.b[a].back();
+    const double n = dims[a] == 0 ? 1.0 : double(dims[a]);
+    cb.cellSize[a] = (hi - lo) / n;
+    cb.cellsPerUnit[a] = hi > lo ? n / (hi - lo) : 0;
+    cb.magnitude[a] = std::max(std::fabs(lo), std::fabs(hi));
+    if (cb.cellSize[a] > 0) minCell = std::min(minCell, cb.cellSize[a]);
+  }
+  cb.minCell = std::isfinite(minCell) ? minCell : 0;
+  return cb;
+}
+
+namespace {
+
+// Tables cost 4 bytes per cell of every occupied block; beyond this the binary search is the better trade.
+constexpr uint64_t kMaxTableBytes = uint64_t(1) << 30;
+constexpr uint64_t kMaxBlocks = uint64_t(1) << 25;
+
+void buildTables(Accel& accel, const Grid& grid) {
+  const auto& dims = grid.dims;
+  // Smallest block size (4, 8 or 16 cells a side) whose block array stays small.
+  uint32_t shift = 0;
+  for (uint32_t s = 2; s <= 4 && shift == 0; ++s) {
+    uint64_t blocks = 1;
+    for (int a = 0; a < 3; ++a) blocks *= (uint64_t(dims[a]) + (1u << s) - 1) >> s;
+    if (blocks <= kMaxBlocks) shift = s;
+  }
+  if (shift == 0) return;
+  std::array<uint32_t, 3> bd;
+  for (int a = 0; a < 3; ++a) bd[a] = uint32_t((uint64_t(dims[a]) + (1u << shift) - 1) >> shift);
+  const uint64_t blockCount = uint64_t(bd[0]) * bd[1] * bd[2];
+  const auto blockOf = [&](const std::array<uint32_t, 3>& c) {
+    return (c[0] >> shift) + bd[0] * ((c[1] >> shift) + uint64_t(bd[1]) * (c[2] >> shift));
+  };
+  // Count occupied blocks first, so that a scattered grid falls back before allocating.
+  std::vector<uint32_t> slot(blockCount, kEmptyCell);
+  uint32_t used = 0;
+  const uint64_t perBlock = uint64_t(1) << (3 * shift);
+  for (const auto* keys : {&grid.cellKeys, &grid.solidKeys}) {
+    for (uint64_t key : *keys) {
+      const uint64_t b = blockOf(cellIndex(dims, key));
+      if (slot[b] == kEmptyCell) {
+        if ((uint64_t(used) + 1) * perBlock * 4 > kMaxTableBytes) return;
+        slot[b] = used++;
+      }
+    }
+  }
+  accel.cellSlots.assign(uint64_t(used) * perBlock, kEmptyCell);
+  const uint32_t m = (1u << shift) - 1;
+  const auto entry = [&](const std::array<uint32_t, 3>& c) -> uint32_t& {
+    return accel.cellSlots[(uint64_t(slot[blockOf(c)]) << (3 * shift)) +
+                           ((c[0] & m) | ((c[1] & m) << shift) | ((c[2] & m) << (2 * shift)))];
+  };
+  for (uint64_t key : grid.solidKeys) entry(cellIndex(dims, key)) = kSolidCell;
+  for (size_t c = 0; c < grid.cellKeys.size(); ++c) entry(cellIndex(dims, grid.cellKeys[c])) = uint32_t(c);
+  accel.blockShift = shift;
+  accel.blockDims = bd;
+  accel.blockSlot = std::move(slot);
+}
+
+}  // namespace
+
+Accel buildAccel(const Scene& scene, const Grid& grid, AccelKind kind) {
+  Accel accel;
+  accel.kind = kind;
+  accel.grid = &grid;
+  accel.triangleCount = uint32_t(scene.triangles.size());
+  accel.sphereCount = uint32_t(scene.spheres.size());
+  accel.planeCount = uint32_t(scene.planes.size());
+  const uint64_t primCount = scene.primitiveCount();
+  if (primCount >= kEmptyCell) fail<LimitError>("scene has ", primCount, " primitives; at most 2^32 - 2 can be traced");
+  accel.triangles.reserve(scene.triangles.size());
+  for (const Triangle& t : scene.triangles) accel.triangles.push_back(prepareTriangle(t));
+  accel.spheres.reserve(scene.spheres.size());
+  for (const Sphere& s : scene.spheres) accel.spheres.push_back(prepareSphere(s));
+  accel.planes = scene.planes;
+
+  const uint32_t firstPlane = accel.triangleCount + accel.sphereCount;
+  for (uint32_t id : grid.outsidePrims) {
+    if (id >= firstPlane) fail<InputError>("grid: outside primitive id ", id, " is not a bounded primitive");
+    accel.alwaysTested.push_back(id);
+  }
+  for (uint32_t p = 0; p < accel.planeCount; ++p) accel.alwaysTested.push_back(firstPlane + p);
+  std::sort(accel.alwaysTested.begin(), accel.alwaysTested.end());
+  accel.alwaysTested.erase(std::unique(accel.alwaysTested.begin(), accel.alwaysTested.end()),
+                           accel.alwaysTested.end());
+
+  // The cell lookup is built for both kinds: the voxels and count modes walk the grid whatever the accel.
+  for (uint32_t id : grid.primIds)
+    if (id >= firstPlane) fail<InputError>("grid: cell primitive id ", id, " is not a bounded primitive");
+  if (grid.occupiedCount() >= kSolidCell)
+    fail<LimitError>("grid has ", grid.occupiedCount(), " occupied cells; at most 2^32 - 2 can be traced");
+  buildTables(accel, grid);
+  accel.boundaries = makeCellBoundaries(grid.bounds, grid.dims);
+  return accel;
+}
+
+}  // namespace vox

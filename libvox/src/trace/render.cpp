@@ -1,0 +1,413 @@
+#include "vox/trace/render.h"
+
+#include <tbb/blocked_range2d.h>
+#include <tbb/combinable.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+
+#include "vox/core/error.h"
+#include "vox/trace/trace_packet.h"
+
+#if __has_include("vox/colormap.h")
+#include "vox/export/colormap.h"
+#define VOX_HAVE_COLORMAP 1
+#endif
+
+namespace vox {
+
+RenderMode parseRenderMode(const std::string& name) {
+  if (name == "shade") return RenderMode::Shade;
+  if (name == "voxels") return RenderMode::Voxels;
+  if (name == "count") return RenderMode::Count;
+  if (name == "normals") return RenderMode::Normals;
+  if (name == "depth") return RenderMode::Depth;
+  fail<UsageError>("unknown mode '", name, "' (expected shade, voxels, count, normals or depth)");
+}
+
+Vec3 heatColor(double value, double maxValue) {
+  double x = maxValue > 0 ? value / maxValue : 0;
+  x = std::clamp(x, 0.0, 1.0);
+  // Piecewise-linear ramp: black-blue, blue, red, yellow, white.
+  static const Vec3 stops[] = {{0, 0, 0.15}, {0.1, 0.2, 0.9}, {0.9, 0.1, 0.1}, {1, 0.85, 0}, {1, 1, 1}};
+  const double f = x * 4;
+  const int i = std::min(3, int(f));
+  const double w = f - i;
+  return stops[i] * (1 - w) + stops[i + 1] * w;
+}
+
+namespace {
+
+Vec3 voxelColor(uint32_t count, uint32_t maxCount) {
+#ifdef VOX_HAVE_COLORMAP
+  return countColor(count, maxCount);
+#else
+  // Fallback until colormap.h exists: the heat ramp above, starting above black so one-primitive cells show.
+  return heatColor(0.25 + 0.75 * double(count) / double(std::max<uint32_t>(maxCount, 1)), 1.0);
+#endif
+}
+
+struct Frame {
+  Vec3 dir, right, up;
+  double halfHeight = 1;  // of the image plane at distance 1 (perspective) or in world units (orthographic)
+};
+
+Frame cameraFrame(const Camera& c) {
+  Frame f;
+  f.dir = normalize(c.direction);
+  f.right = normalize(cross(f.dir, c.up));
+  f.up = cross(f.right, f.dir);
+  if (!isFinite(f.dir) || !isFinite(f.right) || length(f.dir) == 0 || length(f.right) == 0)
+    fail<UsageError>("camera direction and up must be finite, non-zero and not parallel");
+  f.halfHeight = c.kind == CameraKind::Perspective ? std::tan(c.fovDegrees * M_PI / 360.0) : 0.5 * c.orthoHeight;
+  return f;
+}
+
+Ray rayFromFrame(const Camera& camera, const Frame& f, uint32_t width, uint32_t height, double px, double py) {
+  const double aspect = double(width) / double(height);
+  const double sx = 2 * px / width - 1;
+  const double sy = 1 - 2 * py / height;
+  Ray ray;
+  const double h = f.halfHeight;
+  if (camera.kind == CameraKind::Perspective) {
+    ray.origin = camera.center;
+    ray.direction = f.dir + f.right * (sx * h * aspect) + f.up * (sy * h);
+  } else {
+    ray.origin = camera.center + f.right * (sx * h * aspect) + f.up * (sy * h);
+    ray.direction = f.dir;
+  }
+  return ray;
+}
+
+uint64_t splitMix(uint64_t& state) {
+  uint64_t z = (state += 0x9e3779b97f4a7c15ull);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+double uniform(uint64_t& state) { return double(splitMix(state) >> 11) * 0x1.0p-53; }
+
+uint32_t materialOf(const Scene& scene, const Accel& accel, uint32_t prim) {
+  if (prim < accel.triangleCount) return scene.triangles[prim].material;
+  prim -= accel.triangleCount;
+  if (prim < accel.sphereCount) return scene.spheres[prim].material;
+  return scene.planes[prim - accel.sphereCount].material;
+}
+
+Vec3 normalOf(const Accel& accel, const Ray& ray, const Hit& hit) {
+  uint32_t prim = hit.prim;
+  if (prim < accel.triangleCount) return triangleNormal(accel.triangles[prim]);
+  prim -= accel.triangleCount;
+  if (prim < accel.sphereCount) return sphereNormal(accel.spheres[prim], ray, hit.t);
+  return planeNormal(accel.planes[prim - accel.sphereCount]);
+}
+
+struct LightSetup {
+  std::vector<Light> lights;
+  bool castShadows = true;
+};
+
+LightSetup lightsFor(const Scene& scene, const Frame& frame) {
+  LightSetup s;
+  s.lights = scene.lights;
+  if (s.lights.empty()) {
+    Light head;
+    head.kind = LightKind::Directional;
+    head.direction = frame.dir;
+    s.lights.push_back(head);
+    s.castShadows = false;  // a headlight's shadows hide behind what casts them
+  }
+  return s;
+}
+
+// Direction towards the light (unit), distance to it (infinite for directional) and the attenuated colour.
+struct LightSample {
+  Vec3 toLight;
+  double distance;
+  Vec3 color;
+};
+LightSample sampleLight(const Light& light, const Vec3& p) {
+  if (light.kind == LightKind::Directional) return {normalize(-light.direction), kInfinity, light.color};
+  const Vec3 d = light.position - p;
+  const double dist = length(d);
+  const double att = light.attenuation.x + light.attenuation.y * dist + light.attenuation.z * dist * dist;
+  return {dist > 0 ? d / dist : Vec3{0, 0, 1}, dist, att > 0 ? light.color / att : light.color};
+}
+
+struct Renderer {
+  const Scene& scene;
+  const Accel& accel;
+  const RenderOptions& options;
+  Frame frame;
+  LightSetup lights;
+  double sceneSize = 1;
+  uint32_t maxCellPrims = 1;
+
+  // Ambient, diffuse and Blinn-Phong specular with shadow rays. The normal is turned to face the viewer, so
+  // triangles are two-sided and the inside of a sphere is lit like the outside.
+  // `visible(light index, shadow ray)` answers whether the light is seen; it is asked only for lights in front of
+  // the surface, and only when lights cast shadows.
+  template <typename Visible>
+  Vec3 shade(const Ray& ray, const Hit& hit, Visible&& visible) const {
+    const Material& mat = scene.materials[std::min<size_t>(materialOf(scene, accel, hit.prim), scene.materials.size() - 1)];
+    const Vec3 p = ray.origin + ray.direction * hit.t;
+    Vec3 n = normalOf(accel, ray, hit);
+    if (dot(n, ray.direction) > 0) n = -n;
+    const Vec3 view = normalize(-ray.direction);
+    Vec3 color = mul(scene.ambient, mat.diffuse);
+    // Shadow rays start off the surface by a hair relative to the scene and to the magnitude of p.
+    const double pMag = std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+    const double eps = 1e-7 * sceneSize + 64 * std::numeric_limits<double>::epsilon() * pMag;
+    for (size_t li = 0; li < lights.lights.size(); ++li) {
+      const LightSample ls = sampleLight(lights.lights[li], p);
+      const double nl = dot(n, ls.toLight);
+      if (nl <= 0) continue;
+      if (lights.castShadows) {
+        Ray shadow;
+        shadow.origin = p + n * eps;
+        shadow.direction = ls.toLight;
+        shadow.tMin = eps;
+        shadow.tMax = ls.distance - eps;
+        if (shadow.tMax > shadow.tMin && !visible(li, shadow)) continue;
+      }
+      Vec3 c = mat.diffuse * nl;
+      if (mat.specular.x > 0 || mat.specular.y > 0 || mat.specular.z > 0) {
+        const double nh = dot(n, normalize(ls.toLight + view));
+        if (nh > 0) c = c + mat.specular * std::pow(nh, mat.exponent);
+      }
+      color = color + mul(c, ls.color);
+    }
+    return color;
+  }
+
+  // The shade mode for a packet of primary rays and their hits: the shadow rays of each light are traced as packets
+  // too (they start near each other and end at one light, or run parallel). Writes RGB for each ray into out.
+  void shadePacket(std::span<const Ray> rays, std::span<const Hit> hits, float (*out)[3], TraceStats& st) const {
+    const size_t lightCount = lights.lights.size();
+    // First pass: collect the shadow rays, per light, with the slot of their answer (ray * lightCount + light). It
+    // runs the shading itself, so that the rays asked for are exactly those the second pass will ask about.
+    std::vector<std::vector<Ray>> shadowRays(lightCount);
+    std::vector<std::vector<uint32_t>> slots(lightCount);
+    std::vector<uint8_t> seen(rays.size() * lightCount, 1);
+    for (size_t r = 0; r < rays.size() && lights.castShadows; ++r) {
+      if (!hits[r].valid()) continue;
+      shade(rays[r], hits[r], [&](size_t li, const Ray& shadow) {
+        shadowRays[li].push_back(shadow);
+        slots[li].push_back(uint32_t(r * lightCount + li));
+        return true;
+      });
+    }
+    bool blocked[kMaxPacketRays];
+    for (size_t li = 0; li < lightCount; ++li)
+      for (size_t begin = 0; begin < shadowRays[li].size(); begin += kMaxPacketRays) {
+        const size_t count = std::min<size_t>(kMaxPacketRays, shadowRays[li].size() - begin);
+        occludedPacket(accel, std::span(shadowRays[li]).subspan(begin, count), {blocked, count}, &st);
+        for (size_t i = 0; i < count; ++i) seen[slots[li][begin + i]] = !blocked[i];
+      }
+    // Second pass: shade with the answers.
+    for (size_t r = 0; r < rays.size(); ++r) {
+      const auto answer = [&](size_t li, const Ray&) { return seen[r * lightCount + li] != 0; };
+      const Vec3 c = hits[r].valid() ? shade(rays[r], hits[r], answer) : scene.background;
+      out[r][0] = float(c.x), out[r][1] = float(c.y), out[r][2] = float(c.z);
+    }
+  }
+
+  Vec3 shadeVoxel(const Ray& ray, const CellHit& cell) const {
+    Vec3 n;
+    if (cell.entryAxis >= 0) {
+      n.at(cell.entryAxis) = ray.direction[cell.entryAxis] > 0 ? -1 : 1;
+    } else {
+      n = normalize(-ray.direction);
+    }
+    const Vec3 base = cell.solid ? Vec3{0.6, 0.6, 0.6} : voxelColor(cell.primCount, maxCellPrims);
+    Vec3 color = mul(scene.ambient, base);
+    const Vec3 p = ray.origin + ray.direction * cell.t;
+    for (const Light& light : lights.lights) {
+      const LightSample ls = sampleLight(light, p);
+      const double nl = dot(n, ls.toLight);
+      if (nl > 0) color = color + mul(base * nl, ls.color);
+    }
+    return color;
+  }
+
+  // Modes whose samples are the nearest hit of the primary ray: those are traced in packets.
+  bool nearestHitMode() const {
+    return options.mode == RenderMode::Shade || options.mode == RenderMode::Normals || options.mode == RenderMode::Depth;
+  }
+
+  // One sample of the normals or depth mode from its hit; writes `channels` values into out.
+  void fromHit(const Ray& ray, const Hit& hit, float* out) const {
+    switch (options.mode) {
+      case RenderMode::Normals: {
+        Vec3 c;
+        if (hit.valid()) {
+          Vec3 n = normalOf(accel, ray, hit);
+          if (dot(n, ray.direction) > 0) n = -n;
+          c = (n + Vec3{1, 1, 1}) * 0.5;
+        }
+        out[0] = float(c.x), out[1] = float(c.y), out[2] = float(c.z);
+        break;
+      }
+      case RenderMode::Depth:
+        out[0] = hit.valid() ? float(hit.t * length(ray.direction)) : 0.0f;
+        break;
+      default:
+        break;
+    }
+  }
+
+  // One sample of the voxels or count mode.
+  void walkSample(const Ray& ray, float* out, TraceStats& st) const {
+    if (options.mode == RenderMode::Voxels) {
+      const CellHit cell = firstOccupiedCell(accel, ray, &st);
+      const Vec3 c = cell.hit ? shadeVoxel(ray, cell) : scene.background;
+      out[0] = float(c.x), out[1] = float(c.y), out[2] = float(c.z);
+    } else {
+      const uint64_t before = st.cells;
+      traceRay(accel, ray, &st);
+      out[0] = float(st.cells - before);
+    }
+  }
+};
+
+}  // namespace
+
+Ray primaryRay(const Camera& camera, uint32_t width, uint32_t height, double px, double py) {
+  return rayFromFrame(camera, cameraFrame(camera), width, height, px, py);
+}
+
+Image traceImage(const Scene& scene, const Accel& accel, const RenderOptions& options, RenderStats* stats) {
+  if (options.width == 0 || options.height == 0) fail<UsageError>("image size must be at least 1x1");
+  if (options.samples == 0) fail<UsageError>("samples must be at least 1");
+  if (scene.materials.empty()) fail<InputError>("scene has no material");
+  Renderer r{scene, accel, options, cameraFrame(options.camera), {}, 1, 1};
+  r.lights = lightsFor(scene, r.frame);
+  const Box& b = accel.grid->bounds;
+  r.sceneSize = std::max(length(b.hi - b.lo), 1e-300);
+  for (size_t c = 0; c < accel.grid->occupiedCount(); ++c)
+    r.maxCellPrims = std::max<uint32_t>(r.maxCellPrims, uint32_t(accel.grid->cellPrims(c).size()));
+
+  Image image;
+  image.width = options.width;
+  image.height = options.height;
+  const bool single = options.mode == RenderMode::Count || options.mode == RenderMode::Depth;
+  image.channels = single ? 1 : 3;
+  image.pixels.assign(uint64_t(image.width) * image.height * image.channels, 0.0f);
+
+  const uint32_t strata = uint32_t(std::lround(std::sqrt(double(options.samples))));
+  const bool stratified = strata * strata == options.samples;
+  tbb::combinable<TraceStats> perThread;
+  std::atomic<uint64_t> rowsDone{0};
+  const auto start = std::chrono::steady_clock::now();
+  constexpr uint32_t kTile = 16;
+  tbb::parallel_for(
+      tbb::blocked_range2d<uint32_t>(0, image.height, kTile, 0, image.width, kTile),
+      [&](const tbb::blocked_range2d<uint32_t>& tile) {
+        TraceStats& st = perThread.local();
+        // Blocks of 8x8 pixels: each sample index of a block is one packet of primary rays.
+        constexpr uint32_t kBlock = 8;
+        static_assert(kBlock * kBlock <= kMaxPacketRays);
+        for (uint32_t by = tile.rows().begin(); by < tile.rows().end(); by += kBlock) {
+          for (uint32_t bx = tile.cols().begin(); bx < tile.cols().end(); bx += kBlock) {
+            uint32_t px[kMaxPacketRays], py[kMaxPacketRays], count = 0;
+            uint64_t rng[kMaxPacketRays];
+            for (uint32_t y = by; y < std::min(by + kBlock, tile.rows().end()); ++y)
+              for (uint32_t x = bx; x < std::min(bx + kBlock, tile.cols().end()); ++x) {
+                px[count] = x, py[count] = y;
+                rng[count++] = options.seed ^ ((uint64_t(y) << 32) | x) * 0x9e3779b97f4a7c15ull;
+              }
+            float sum[kMaxPacketRays][3] = {};
+            Ray rays[kMaxPacketRays];
+            Hit hits[kMaxPacketRays];
+            for (uint32_t s = 0; s < options.samples; ++s) {
+              for (uint32_t p = 0; p < count; ++p) {
+                double sx = px[p] + 0.5, sy = py[p] + 0.5;
+                if (options.samples > 1) {
+                  if (stratified) {
+                    sx = px[p] + ((s % strata) + uniform(rng[p])) / strata;
+                    sy = py[p] + ((s / strata) + uniform(rng[p])) / strata;
+                  } else {
+                    sx = px[p] + uniform(rng[p]);
+                    sy = py[p] + uniform(rng[p]);
+                  }
+                }
+                rays[p] = rayFromFrame(options.camera, r.frame, image.width, image.height, sx, sy);
+              }
+              float value[kMaxPacketRays][3];
+              if (r.nearestHitMode()) {
+                tracePacket(accel, {rays, count}, {hits, count}, &st);
+                if (options.mode == RenderMode::Shade) r.shadePacket({rays, count}, {hits, count}, value, st);
+                else
+                  for (uint32_t p = 0; p < count; ++p) r.fromHit(rays[p], hits[p], value[p]);
+              } else {
+                for (uint32_t p = 0; p < count; ++p) r.walkSample(rays[p], value[p], st);
+              }
+              for (uint32_t p = 0; p < count; ++p)
+                for (uint32_t c = 0; c < image.channels; ++c) sum[p][c] += value[p][c];
+            }
+            for (uint32_t p = 0; p < count; ++p) {
+              float* out = image.at(px[p], py[p]);
+              for (uint32_t c = 0; c < image.channels; ++c) out[c] = sum[p][c] / float(options.samples);
+            }
+          }
+        }
+        if (options.progress && tile.cols().end() == image.width) {
+          const uint64_t done = rowsDone.fetch_add(tile.rows().size()) + tile.rows().size();
+          options.progress(double(done) / image.height);
+        }
+      });
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  RenderStats rs;
+  perThread.combine_each([&](const TraceStats& s) { rs.trace += s; });
+  rs.traceSeconds = seconds;
+  if (options.mode == RenderMode::Count) {
+    float maxCount = 0;
+    for (float v : image.pixels) maxCount = std::max(maxCount, v);
+    rs.countMax = maxCount;
+    Image heat;
+    heat.width = image.width;
+    heat.height = image.height;
+    heat.channels = 3;
+    heat.pixels.resize(uint64_t(image.width) * image.height * 3);
+    for (uint64_t i = 0; i < uint64_t(image.width) * image.height; ++i) {
+      const Vec3 c = heatColor(image.pixels[i], maxCount);
+      heat.pixels[3 * i] = float(c.x), heat.pixels[3 * i + 1] = float(c.y), heat.pixels[3 * i + 2] = float(c.z);
+    }
+    image = std::move(heat);
+  } else if (options.mode == RenderMode::Depth) {
+    bool any = false;
+    for (float v : image.pixels) {
+      if (v <= 0) continue;
+      rs.depthMin = any ? std::min(rs.depthMin, double(v)) : v;
+      rs.depthMax = any ? std::max(rs.depthMax, double(v)) : v;
+      any = true;
+    }
+  }
+  if (stats) *stats = rs;
+  return image;
+}
+
+Image depthToGrey(const Image& depth) {
+  Image grey = depth;
+  float lo = 0, hi = 0;
+  bool any = false;
+  for (float v : depth.pixels) {
+    if (v <= 0) continue;
+    lo = any ? std::min(lo, v) : v;
+    hi = any ? std::max(hi, v) : v;
+    any = true;
+  }
+  for (float& v : grey.pixels) {
+    if (v <= 0) continue;
+    // Linear in inverse depth, so that a floor running to the horizon does not wash out everything near.
+    const double f = hi > lo ? (1.0 / v - 1.0 / hi) / (1.0 / lo - 1.0 / hi) : 1.0;
+    v = float(0.15 + 0.85 * f);
+  }
+  return grey;
+}
+
+}  // namespace vox

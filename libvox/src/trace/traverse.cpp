@@ -1,0 +1,308 @@
+#include "vox/trace/traverse.h"
+
+#include <algorithm>
+
+#include "trace/mailbox.h"
+
+namespace vox {
+
+namespace {
+
+constexpr double kRel = kWalkRel;
+
+// Largest i in [0, n-1] with b[i] <= c (c below the grid gives 0, above gives n-1). The multiplication only guesses;
+// the comparisons with the table (the values of cellBoundary) decide.
+int64_t cellBelow(const CellBoundaries& cb, int a, double c) {
+  const double* b = cb.b[a].data();
+  const int64_t n = cb.dims[a];
+  double guess = std::floor((c - b[0]) * cb.cellsPerUnit[a]);
+  if (!(guess >= 0)) guess = 0;
+  if (guess > double(n - 1)) guess = double(n - 1);
+  int64_t i = int64_t(guess);
+  while (i > 0 && b[i] > c) --i;
+  while (i < n - 1 && b[i + 1] <= c) ++i;
+  return i;
+}
+
+// Smallest i in [0, n-1] with b[i+1] >= c.
+int64_t cellAbove(const CellBoundaries& cb, int a, double c) {
+  const double* b = cb.b[a].data();
+  const int64_t n = cb.dims[a];
+  int64_t i = cellBelow(cb, a, c);
+  while (i > 0 && b[i] >= c) --i;
+  while (i < n - 1 && b[i + 1] < c) ++i;
+  return i;
+}
+
+}  // namespace
+
+RayAxes rayAxes(const CellBoundaries& cells, const Ray& ray) {
+  RayAxes ax;
+  for (int a = 0; a < 3; ++a) {
+    const double d = ray.direction[a];
+    ax.tolPos[a] = positionTolerance(cells, a, ray.origin[a]);
+    ax.inv[a] = 1.0 / d;
+    ax.divide[a] = !std::isnormal(ax.inv[a]);
+    ax.tol[a] = d == 0 ? 0 : ax.divide[a] ? ax.tolPos[a] / std::fabs(d) : ax.tolPos[a] * std::fabs(ax.inv[a]);
+  }
+  // Divided by the largest component rather than the length (no square root): at most sqrt(3) times larger, and a
+  // larger slack only makes the stop rule more careful.
+  const Vec3& d = ray.direction;
+  const double dirMax = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
+  ax.hitSlack = hitSlackLength(cells, ray.origin) / dirMax;
+  return ax;
+}
+
+namespace {
+
+// The parameters [tLo, tHi] within which `ray` (finite, nonzero direction, restricted to [tMin, tMax]) can be inside
+// the closed grid box, widened by the tolerances; `entryAxis` is the axis whose slab sets tLo (-1 when tMin does).
+// False when the ray misses the box.
+bool gridSpan(const CellBoundaries& cells, const Ray& ray, const RayAxes& ax, double& tLo, double& tHi,
+              int& entryAxis) {
+  // Slab test against the closed grid box [b(0), b(n)].
+  tLo = ray.tMin;
+  tHi = ray.tMax;
+  entryAxis = -1;
+  for (int a = 0; a < 3; ++a) {
+    const double o = ray.origin[a], d = ray.direction[a];
+    const double gridLo = cells.b[a].front(), gridHi = cells.b[a].back();
+    if (d == 0) {
+      if (o < gridLo || o > gridHi) return false;
+      continue;
+    }
+    double t0 = ax.crossing(a, gridLo, o, d);
+    double t1 = ax.crossing(a, gridHi, o, d);
+    if (t0 > t1) std::swap(t0, t1);
+    t0 -= ax.tol[a] + kRel * std::fabs(t0);
+    t1 += ax.tol[a] + kRel * std::fabs(t1);
+    if (t0 > tLo) {
+      tLo = t0;
+      entryAxis = a;
+    }
+    tHi = std::min(tHi, t1);
+  }
+  return tLo <= tHi;
+}
+
+}  // namespace
+
+void GridWalker::init(const CellBoundaries& cells, const Ray& ray) {
+  done_ = true;
+  for (int a = 0; a < 3; ++a) {
+    org_[a] = ray.origin[a];
+    dir_[a] = ray.direction[a];
+    bnd_[a] = cells.b[a].data();
+    dims_[a] = cells.dims[a];
+  }
+  if (!isFinite(ray.origin) || !isFinite(ray.direction) || std::isnan(ray.tMin) || std::isnan(ray.tMax)) return;
+  if (ray.direction.x == 0 && ray.direction.y == 0 && ray.direction.z == 0) return;
+  if (dims_[0] == 0 || dims_[1] == 0 || dims_[2] == 0) return;
+
+  ax_ = rayAxes(cells, ray);
+  double tLo, tExitBox;
+  int entry;
+  if (!gridSpan(cells, ray, ax_, tLo, tExitBox, entry)) return;
+  tHi_ = ray.tMax + hitSlack(ray.tMax);
+
+  // The start cell, from the point at tLo. Each index is biased against the direction of travel by the positional
+  // slack, so a start point that rounding put just past a boundary still starts in the cell before it; the walk
+  // then steps across at once.
+  for (int a = 0; a < 3; ++a) {
+    const double p = dir_[a] == 0 ? org_[a] : org_[a] + tLo * dir_[a];
+    if (dir_[a] > 0) {
+      idx_[a] = cellBelow(cells, a, p - ax_.tolPos[a]);
+      step_[a] = 1;
+    } else if (dir_[a] < 0) {
+      idx_[a] = cellAbove(cells, a, p + ax_.tolPos[a]);
+      step_[a] = -1;
+    } else {
+      idx_[a] = cellBelow(cells, a, p);
+      step_[a] = 0;
+    }
+  }
+  for (int a = 0; a < 3; ++a) tNext_[a] = nextT(a);
+  tCur_ = tLo;
+  entryAxis_ = entry;
+  maxSteps_ = dims_[0] + dims_[1] + dims_[2] + 3;
+  done_ = false;
+}
+
+void GridWalker::queueExtras(int m, double tm, const WalkCell& from, bool n1, bool n2) {
+  int others[2], count = 0;
+  if (n1) others[count++] = m == 0 ? 1 : 0;
+  if (n2) others[count++] = m == 2 ? 1 : 2;
+  for (int subset = 1; subset < (1 << count); ++subset) {
+    int64_t c[3] = {idx_[0], idx_[1], idx_[2]};
+    int lastAxis = -1;
+    for (int s = 0; s < count; ++s)
+      if (subset & (1 << s)) {
+        c[others[s]] += step_[others[s]];
+        lastAxis = others[s];
+      }
+    if (uint64_t(c[0]) < dims_[0] && uint64_t(c[1]) < dims_[1] && uint64_t(c[2]) < dims_[2]) {
+      WalkCell& e = queue_[queued_++];
+      e = from;
+      e.idx = {uint32_t(c[0]), uint32_t(c[1]), uint32_t(c[2])};
+      e.tEnter = tm;
+      e.entryAxis = lastAxis;
+      e.extra = true;
+    }
+  }
+}
+
+// Skips the empty block holding the current cell (no primitive can be found in it). Its exit parameter tX is the
+// smallest crossing of its far faces (on axis m). When the ray passes within twice the tolerance of another far face
+// at tX (near an edge or corner of the block; by monotony that is where it comes closest), nothing is skipped and the
+// ordinary steps with their extra cells handle it. Otherwise every axis is advanced, without reporting cells, over
+// the boundaries inside the block that the ray crosses before T = tX - 2 (tol + kRel |tX|): those steps only leave
+// cells of the block, and none of their extra cells can lie outside it (the ray is farther than the tolerance from
+// the other far faces, and the steps near the exit face come after T). The walker is then in the state the ordinary
+// walk reaches at T and goes on from there; every index increment counts as a step, so the bound on steps holds.
+void GridWalker::fastForward() {
+  const int64_t mask = blockMask();
+  double tB[3];
+  int64_t far[3];
+  for (int a = 0; a < 3; ++a) {
+    if (step_[a] == 0) {
+      tB[a] = std::numeric_limits<double>::infinity();
+      far[a] = -1;
+      continue;
+    }
+    far[a] = step_[a] > 0 ? std::min<int64_t>((idx_[a] | mask) + 1, int64_t(dims_[a])) : (idx_[a] & ~mask);
+    const double b = bnd_[a][far[a]];
+    tB[a] = ax_.crossing(a, b, org_[a], dir_[a]);
+  }
+  int m = 0;
+  if (tB[1] < tB[m]) m = 1;
+  if (tB[2] < tB[m]) m = 2;
+  const double tX = tB[m];
+  if (!std::isfinite(tX)) return;
+  for (int a = 0; a < 3; ++a)
+    if (a != m && std::isfinite(tB[a]) &&
+        (tB[a] - tX) * std::fabs(dir_[a]) <= 2 * (ax_.tolPos[a] + kRel * std::fabs(tX * dir_[a])))
+      return;
+  const double T = tX - 2 * (ax_.tol[m] + kRel * std::fabs(tX));
+  for (int a = 0; a < 3; ++a) {
+    if (step_[a] == 0) continue;
+    while (idx_[a] + (step_[a] > 0 ? 1 : 0) != far[a] && tNext_[a] < T) {
+      idx_[a] += step_[a];
+      ++steps_;
+      if (tNext_[a] > tCur_) {
+        tCur_ = tNext_[a];
+        entryAxis_ = a;
+      }
+      tNext_[a] = nextT(a);
+    }
+  }
+}
+
+namespace {
+
+inline void consider(const Accel& accel, uint32_t id, const Ray& ray, Hit& best, TraceStats& st) {
+  double t;
+  ++st.tests;
+  if (intersectPrimitive(accel, id, ray, t) && closer(t, id, best)) {
+    best.t = t;
+    best.prim = id;
+  }
+}
+
+}  // namespace
+
+Hit traceRay(const Accel& accel, const Ray& ray, TraceStats* stats) {
+  TraceStats st;
+  st.rays = 1;
+  Hit best;
+  if (accel.kind == AccelKind::None) {
+    const uint32_t n = accel.primitiveCount();
+    for (uint32_t id = 0; id < n; ++id) consider(accel, id, ray, best, st);
+  } else {
+    for (uint32_t id : accel.alwaysTested) consider(accel, id, ray, best, st);
+    GridWalker walker(accel, ray);
+    Mailbox<64> mailbox;
+    WalkCell cell;
+    while (walker.next(cell)) {
+      ++st.cells;
+      const uint32_t c = accel.lookup(cell.idx[0], cell.idx[1], cell.idx[2]);
+      if (c < kSolidCell) {
+        for (uint32_t id : accel.cellPrims(c)) {
+          if (mailbox.seen(id)) {
+            ++st.mailboxSkips;
+            continue;
+          }
+          consider(accel, id, ray, best, st);
+        }
+      }
+      // A hit may lie beyond this cell (a primitive spanning cells): it is kept, and accepted only once the walk
+      // has passed every cell that could hold a nearer one.
+      if (best.valid() && best.t + walker.hitSlack(best.t) < cell.tExit - cell.exitSlack) break;
+    }
+  }
+  if (stats) *stats += st;
+  return best;
+}
+
+bool occluded(const Accel& accel, const Ray& ray, TraceStats* stats) {
+  TraceStats st;
+  st.rays = 1;
+  bool hit = false;
+  double t;
+  if (accel.kind == AccelKind::None) {
+    const uint32_t n = accel.primitiveCount();
+    for (uint32_t id = 0; id < n && !hit; ++id) {
+      ++st.tests;
+      hit = intersectPrimitive(accel, id, ray, t);
+    }
+  } else {
+    for (size_t i = 0; i < accel.alwaysTested.size() && !hit; ++i) {
+      ++st.tests;
+      hit = intersectPrimitive(accel, accel.alwaysTested[i], ray, t);
+    }
+    GridWalker walker(accel, ray);
+    Mailbox<64> mailbox;
+    WalkCell cell;
+    while (!hit && walker.next(cell)) {
+      ++st.cells;
+      const uint32_t c = accel.lookup(cell.idx[0], cell.idx[1], cell.idx[2]);
+      if (c >= kSolidCell) continue;
+      for (uint32_t id : accel.cellPrims(c)) {
+        if (mailbox.seen(id)) {
+          ++st.mailboxSkips;
+          continue;
+        }
+        ++st.tests;
+        if (intersectPrimitive(accel, id, ray, t)) {
+          hit = true;
+          break;
+        }
+      }
+    }
+  }
+  if (stats) *stats += st;
+  return hit;
+}
+
+CellHit firstOccupiedCell(const Accel& accel, const Ray& ray, TraceStats* stats) {
+  TraceStats st;
+  st.rays = 1;
+  CellHit result;
+  GridWalker walker(accel, ray);
+  WalkCell cell;
+  while (walker.next(cell)) {
+    ++st.cells;
+    const uint32_t c = accel.lookup(cell.idx[0], cell.idx[1], cell.idx[2]);
+    if (c == kEmptyCell) continue;
+    result.hit = true;
+    result.t = std::max(cell.tEnter, ray.tMin);
+    result.idx = cell.idx;
+    result.entryAxis = cell.tEnter <= ray.tMin ? -1 : cell.entryAxis;
+    result.solid = c == kSolidCell;
+    result.primCount = result.solid ? 0 : uint32_t(accel.cellPrims(c).size());
+    break;
+  }
+  if (stats) *stats += st;
+  return result;
+}
+
+}  // namespace vox

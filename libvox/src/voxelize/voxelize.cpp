@@ -1,0 +1,428 @@
+#include "vox/voxelize/voxelize.h"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <chrono>
+#include <cmath>
+
+#include "voxelize/cell_range.h"
+#include "voxelize/radix_sort.h"
+#include "voxelize/triangle_filter.h"
+#include "vox/core/error.h"
+#include "vox/voxelize/overlap.h"
+
+namespace vox {
+
+namespace {
+
+Box paddedBounds(Box b) {
+  const Vec3 extent = b.hi - b.lo;
+  const double largest = std::max({extent.x, extent.y, extent.z});
+  for (int a = 0; a < 3; ++a) {
+    if (b.hi[a] > b.lo[a]) continue;
+    // A flat scene still needs cells across its thin axis: pad by 1% of the largest extent (or 0.5 for a point),
+    // but at least enough ulps that lo < hi holds far from the origin.
+    double pad = largest > 0 ? 0.01 * largest : 0.5;
+    pad = std::max(pad, 4 * std::fabs(b.lo[a]) * DBL_EPSILON + DBL_MIN);
+    b.lo.at(a) -= pad;
+    b.hi.at(a) += pad;
+  }
+  return b;
+}
+
+// The boundary formula b(i) = lo + (hi - lo) * i / n need not give b(n) == hi in floating point, which would leave a
+// sliver of the bounds (and primitives lying on the top face) outside every cell. Nudge hi up by ulps until the
+// formula reproduces it exactly; the change is a few ulps at most.
+// Bounds the user gave make a failure a usage error; bounds taken from the scene make it the scene's (exit 2).
+template <typename E>
+void alignUpperBounds(Grid& grid) {
+  for (int a = 0; a < 3; ++a) {
+    int steps = 0;
+    while (cellBoundary(grid.bounds, grid.dims, a, grid.dims[a]) != grid.bounds.hi[a]) {
+      grid.bounds.hi.at(a) = std::nextafter(grid.bounds.hi[a], HUGE_VAL);
+      if (++steps > 4096)
+        fail<E>("bounds [", grid.bounds.lo[a], ", ", grid.bounds.hi[a], "] on axis ", "xyz"[a],
+                " cannot be divided into ", grid.dims[a], " cells in double precision (coordinates of very "
+                "different magnitudes?)");
+    }
+  }
+}
+
+void checkDims(const std::array<uint32_t, 3>& dims) {
+  for (uint32_t n : dims)
+    if (n == 0 || n > kMaxCellsPerAxis)
+      fail<UsageError>("grid dimension ", n, " out of range (1 to ", kMaxCellsPerAxis, " cells per axis)");
+}
+
+// Cells a primitive may touch, from its bounding box; nullopt when the box misses the grid.
+struct CellRange {
+  std::array<int64_t, 3> first, last;
+  uint64_t count() const {
+    return uint64_t(last[0] - first[0] + 1) * uint64_t(last[1] - first[1] + 1) * uint64_t(last[2] - first[2] + 1);
+  }
+};
+
+std::optional<CellRange> rangeOf(const Grid& grid, const Box& box) {
+  CellRange r;
+  for (int a = 0; a < 3; ++a) {
+    const auto [f, l] = cellRange(grid.bounds, grid.dims, a, box.lo[a], box.hi[a]);
+    if (f > l) return std::nullopt;
+    r.first[a] = f;
+    r.last[a] = l;
+  }
+  return r;
+}
+
+bool inside(const Box& inner, const Box& outer) {
+  for (int a = 0; a < 3; ++a)
+    if (inner.lo[a] < outer.lo[a] || inner.hi[a] > outer.hi[a]) return false;
+  return true;
+}
+
+// Cells of a row (fixed indices on two axes) that a triangle's plane can reach: the triangle's cells lie within a
+// cell of its plane, so only those need the overlap test. The sweep axis is the normal's dominant one. The range is
+// widened by a margin far above the rounding error of the computed normal (and the plane is not used at all when
+// that normal is too uncertain), so the pruning never drops a cell the full test would take.
+struct PlaneSweep {
+  int axis = 0;
+  bool usable = false;
+  Vec3 n, origin;
+  double margin = 0;
+
+  PlaneSweep(const TriangleFilter& f, const Triangle& t, const Box& triBox)
+      : n{f.normal[0], f.normal[1], f.normal[2]}, origin(t.v[0]) {
+    const Vec3 an{std::fabs(n.x), std::fabs(n.y), std::fabs(n.z)};
+    axis = an.x >= an.y && an.x >= an.z ? 0 : (an.y >= an.z ? 1 : 2);
+    const double na = an[axis];
+    const double relErr = (f.normalErr[0] + f.normalErr[1] + f.normalErr[2]) / na;
+    if (!(na > 0) || !(relErr < 1e-6) || !f.usable) return;
+    const double diag = length(triBox.hi - triBox.lo);
+    margin = 1e-4 * diag + 1e-12 * (std::fabs(origin.x) + std::fabs(origin.y) + std::fabs(origin.z));
+    usable = true;
+  }
+
+  // Interval on `axis` of the plane over the rectangle [b0, b1] x [c0, c1] of the other two axes, widened.
+  std::pair<double, double> range(double b0, double b1, double c0, double c1) const {
+    const int b = (axis + 1) % 3, c = (axis + 2) % 3;
+    const double kb = -n[b] / n[axis], kc = -n[c] / n[axis];
+    const double pb0 = kb * (b0 - origin[b]), pb1 = kb * (b1 - origin[b]);
+    const double pc0 = kc * (c0 - origin[c]), pc1 = kc * (c1 - origin[c]);
+    const double lo = origin[axis] + std::min(pb0, pb1) + std::min(pc0, pc1);
+    const double hi = origin[axis] + std::max(pb0, pb1) + std::max(pc0, pc1);
+    const double m = margin + 1e-9 * (std::fabs(lo) + std::fabs(hi));
+    return {lo - m, hi + m};
+  }
+};
+
+double triangleArea(const Triangle& t) { return 0.5 * length(cross(t.v[1] - t.v[0], t.v[2] - t.v[0])); }
+
+// A generous estimate of the references a primitive makes: a surface of area A crosses at most about
+// 3 A / h^2 + 2 P / h + 8 cells of side h (h the smallest cell side), and never more than its bounding range.
+double estimateReferences(const Scene& scene, const Grid& grid) {
+  double h = HUGE_VAL;
+  for (int a = 0; a < 3; ++a) h = std::min(h, (grid.bounds.hi[a] - grid.bounds.lo[a]) / grid.dims[a]);
+  double total = 0;
+  // bbox takes the whole range; center takes the cells whose centres lie in the footprint, at most the range too.
+  const bool wholeRange = grid.method == OverlapMethod::BBox || grid.method == OverlapMethod::Center;
+  auto add = [&](const Box& box, double area, double perimeter) {
+    const auto r = rangeOf(grid, box);
+    if (!r) return;
+    const double range = double(r->count());
+    total += wholeRange ? range : std::min(range, 3 * area / (h * h) + 2 * perimeter / h + 8);
+  };
+  for (const auto& t : scene.triangles)
+    add(triangleBounds(t), triangleArea(t),
+        length(t.v[1] - t.v[0]) + length(t.v[2] - t.v[1]) + length(t.v[0] - t.v[2]));
+  for (const auto& s : scene.spheres) {
+    const Box b = sphereBounds(s);
+    const Vec3 e = (b.hi - b.lo) * 0.5;
+    add(b, 4 * M_PI * std::max({e.x * e.y, e.y * e.z, e.x * e.z}), 0);
+  }
+  return total;
+}
+
+}  // namespace
+
+namespace {
+// The bounds' extents divided by the largest one (each in (0, 1]).
+Vec3 relativeExtents(const Box& bounds) {
+  const Vec3 e = bounds.hi - bounds.lo;
+  const double largest = std::max({e.x, e.y, e.z});
+  return {e.x / largest, e.y / largest, e.z / largest};
+}
+}  // namespace
+
+std::array<uint32_t, 3> dimsForResolution(const Box& bounds, uint32_t resolution) {
+  if (resolution == 0 || resolution > kMaxCellsPerAxis)
+    fail<UsageError>("resolution ", resolution, " out of range (1 to ", kMaxCellsPerAxis, ")");
+  // Extents relative to the largest, so that bounds of subnormal width cannot underflow the cell size to 0.
+  const Vec3 e = relativeExtents(bounds);
+  std::array<uint32_t, 3> dims;
+  for (int a = 0; a < 3; ++a)
+    dims[a] = uint32_t(std::clamp<double>(std::round(e[a] * resolution), 1, resolution));
+  return dims;
+}
+
+std::array<uint32_t, 3> defaultDims(const Box& bounds, size_t boundedPrimitives) {
+  const Vec3 e = relativeExtents(bounds);
+  const double target = std::max(1.0, kCellsPerPrimitive * double(boundedPrimitives));
+  const double cell = std::cbrt(e.x * e.y * e.z / target);
+  std::array<uint32_t, 3> dims;
+  for (int a = 0; a < 3; ++a)
+    dims[a] = uint32_t(std::clamp<double>(std::round(e[a] / cell), 1, 1024));
+  return dims;
+}
+
+Grid planGrid(const Scene& scene, const VoxelizeOptions& options) {
+  Grid grid;
+  grid.method = options.method;
+  if (options.bounds) {
+    const Box& b = *options.bounds;
+    if (!isFinite(b.lo) || !isFinite(b.hi)) fail<UsageError>("bounds must be finite numbers");
+    for (int a = 0; a < 3; ++a)
+      if (!(b.lo[a] < b.hi[a])) fail<UsageError>("bounds: minimum must be below maximum on every axis");
+    grid.bounds = b;
+  } else if (const auto b = sceneBounds(scene)) {
+    grid.bounds = paddedBounds(*b);
+    for (int a = 0; a < 3; ++a)
+      if (!std::isfinite(grid.bounds.hi[a] - grid.bounds.lo[a]))
+        fail<InputError>("scene bounds [", grid.bounds.lo[a], ", ", grid.bounds.hi[a], "] on axis ", "xyz"[a],
+                         " are wider than the largest double: no grid can divide them");
+  } else {
+    grid.bounds = {{0, 0, 0}, {1, 1, 1}};
+    grid.dims = {1, 1, 1};
+    return grid;  // 0 + (1 - 0) * 1 / 1 == 1: already aligned
+  }
+  if (options.dims) {
+    grid.dims = *options.dims;
+  } else if (options.resolution) {
+    grid.dims = dimsForResolution(grid.bounds, *options.resolution);
+  } else {
+    grid.dims = defaultDims(grid.bounds, scene.boundedCount());
+  }
+  checkDims(grid.dims);
+  if (options.bounds)
+    alignUpperBounds<UsageError>(grid);
+  else
+    alignUpperBounds<InputError>(grid);
+  return grid;
+}
+
+Grid voxelizeScene(const Scene& scene, const VoxelizeOptions& options, VoxelizeStats* stats) {
+  const auto start = std::chrono::steady_clock::now();
+  Grid grid = planGrid(scene, options);
+  const size_t nTri = scene.triangles.size();
+  const size_t nBounded = scene.boundedCount();
+  if (nBounded == 0) return grid;
+  if (nBounded > UINT32_MAX) fail<LimitError>("too many primitives (", nBounded, ")");
+
+  const double estimate = estimateReferences(scene, grid);
+  constexpr double kBytesPerReference = 44;  // packed entry, radix buffer, and the compressed cell lists
+  if (estimate * kBytesPerReference > double(options.memoryLimitBytes))
+    fail<LimitError>("grid ", grid.dims[0], "x", grid.dims[1], "x", grid.dims[2], " needs about ",
+                     uint64_t(estimate * kBytesPerReference / (1 << 20)), " MiB for ", uint64_t(estimate),
+                     " cell references, more than the ", options.memoryLimitBytes >> 20, " MiB allowed");
+
+  std::array<std::vector<double>, 3> boundary;
+  for (int a = 0; a < 3; ++a) {
+    boundary[a].resize(size_t(grid.dims[a]) + 1);
+    for (int64_t i = 0; i <= int64_t(grid.dims[a]); ++i) boundary[a][i] = cellBoundary(grid.bounds, grid.dims, a, i);
+  }
+
+  std::array<double, 3> boundaryScale;
+  for (int a = 0; a < 3; ++a) boundaryScale[a] = double(grid.dims[a]) / (grid.bounds.hi[a] - grid.bounds.lo[a]);
+
+  const int primBits = std::max(1, int(std::bit_width(uint64_t(nBounded - 1))));
+  const int keyBits = int(std::bit_width(grid.cellCount() - 1));
+  const bool packed = primBits + keyBits <= 64;
+  const uint64_t primMask = (uint64_t(1) << primBits) - 1;
+
+  struct Local {
+    std::vector<uint64_t> packedRefs;
+    std::vector<std::pair<uint64_t, uint32_t>> pairRefs;
+    uint64_t tested = 0, fallbacks = 0, degenerate = 0;
+    std::vector<uint32_t> outside;
+  };
+  tbb::enumerable_thread_specific<Local> locals;
+  std::atomic<size_t> done{0};
+  std::atomic<bool> cancelled{false};
+  const std::array<uint32_t, 3> dims = grid.dims;
+
+  auto voxelizePrimitive = [&](size_t id, Local& local) {
+    auto emit = [&](int64_t i, int64_t j, int64_t k) {
+      const uint64_t key = cellKey(dims, i, j, k);
+      if (packed) {
+        local.packedRefs.push_back((key << primBits) | id);
+      } else {
+        local.pairRefs.emplace_back(key, uint32_t(id));
+      }
+    };
+    const bool isTri = id < nTri;
+    const Box primBox = isTri ? triangleBounds(scene.triangles[id]) : sphereBounds(scene.spheres[id - nTri]);
+    if (options.bounds && !inside(primBox, grid.bounds)) local.outside.push_back(uint32_t(id));
+    const auto range = rangeOf(grid, primBox);
+    if (!range) return;
+    const auto& [first, last] = *range;
+    if (options.method == OverlapMethod::BBox) {
+      for (int64_t k = first[2]; k <= last[2]; ++k)
+        for (int64_t j = first[1]; j <= last[1]; ++j)
+          for (int64_t i = first[0]; i <= last[0]; ++i) emit(i, j, k);
+      local.tested += range->count();
+      return;
+    }
+    auto box = [&](int64_t i, int64_t j, int64_t k) {
+      return Box{{boundary[0][i], boundary[1][j], boundary[2][k]},
+                 {boundary[0][i + 1], boundary[1][j + 1], boundary[2][k + 1]}};
+    };
+    if (options.method == OverlapMethod::Center) {
+      // The course's quick test: the cell's centre inside the footprint (bounding box, or the sphere itself).
+      Mat4 toObject;
+      if (!isTri) toObject = inverse(scene.spheres[id - nTri].transform);
+      for (int64_t k = first[2]; k <= last[2]; ++k)
+        for (int64_t j = first[1]; j <= last[1]; ++j)
+          for (int64_t i = first[0]; i <= last[0]; ++i) {
+            const Box b = box(i, j, k);
+            const Vec3 c = (b.lo + b.hi) * 0.5;
+            bool take;
+            if (isTri) {
+              take = c.x >= primBox.lo.x && c.x <= primBox.hi.x && c.y >= primBox.lo.y && c.y <= primBox.hi.y &&
+                     c.z >= primBox.lo.z && c.z <= primBox.hi.z;
+            } else {
+              const Sphere& s = scene.spheres[id - nTri];
+              const Vec3 d = transformPoint(toObject, c) - s.center;
+              take = dot(d, d) <= s.radius * s.radius;
+            }
+            if (take) emit(i, j, k);
+          }
+      local.tested += range->count();
+      return;
+    }
+    if (!isTri) {
+      const Sphere& s = scene.spheres[id - nTri];
+      for (int64_t k = first[2]; k <= last[2]; ++k)
+        for (int64_t j = first[1]; j <= last[1]; ++j)
+          for (int64_t i = first[0]; i <= last[0]; ++i) {
+            bool fallback = false;
+            const bool hit = options.method == OverlapMethod::Sat ? sphereBoxSat(s, box(i, j, k))
+                                                                   : sphereBoxFiltered(s, box(i, j, k), &fallback);
+            local.fallbacks += fallback;
+            if (hit) emit(i, j, k);
+          }
+      local.tested += range->count();
+      return;
+    }
+    const Triangle& t = scene.triangles[id];
+    TriangleFilter filter(t);
+    {
+      // |corner - origin| over every cell of the range, for the filter's error bounds (rounded up generously).
+      double qMax[3];
+      for (int ax = 0; ax < 3; ++ax)
+        qMax[ax] = 1.0000001 * std::max(std::fabs(boundary[ax][first[ax]] - filter.origin[ax]),
+                                        std::fabs(boundary[ax][last[ax] + 1] - filter.origin[ax]));
+      filter.prepare(qMax);
+    }
+    const bool sat = options.method == OverlapMethod::Sat;
+    if (isDegenerate(t)) ++local.degenerate;
+    const PlaneSweep sweep(filter, t, primBox);
+    const int a = sweep.axis, b = (a + 1) % 3, c = (a + 2) % 3;
+    int64_t idx[3];
+    for (idx[c] = first[c]; idx[c] <= last[c]; ++idx[c]) {
+      for (idx[b] = first[b]; idx[b] <= last[b]; ++idx[b]) {
+        int64_t from = first[a], to = last[a];
+        if (sweep.usable) {
+          const auto [lo, hi] = sweep.range(boundary[b][idx[b]], boundary[b][idx[b] + 1], boundary[c][idx[c]],
+                                            boundary[c][idx[c] + 1]);
+          const auto& table = boundary[a];
+          const auto r = cellRangeOnAxis(
+              int64_t(dims[a]), boundaryScale[a], [&](int64_t i) { return table[size_t(i)]; }, lo, hi);
+          from = std::max(from, r[0]);
+          to = std::min(to, r[1]);
+        }
+        double lo[3], hi[3], rel[2][3];
+        for (int axis : {b, c}) {
+          lo[axis] = boundary[axis][idx[axis]];
+          hi[axis] = boundary[axis][idx[axis] + 1];
+          rel[0][axis] = lo[axis] - filter.origin[axis];
+          rel[1][axis] = hi[axis] - filter.origin[axis];
+        }
+        for (idx[a] = from; idx[a] <= to; ++idx[a]) {
+          lo[a] = boundary[a][idx[a]];
+          hi[a] = boundary[a][idx[a] + 1];
+          rel[0][a] = lo[a] - filter.origin[a];
+          rel[1][a] = hi[a] - filter.origin[a];
+          const FilterResult r = filter.test(lo, hi, rel);
+          bool hit = r == FilterResult::Overlap;
+          if (r == FilterResult::Unknown) {
+            // sat takes undecided contacts; exact asks CGAL.
+            ++local.fallbacks;
+            hit = sat || triangleBoxExact(t, Box{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}});
+          }
+          if (hit) emit(idx[0], idx[1], idx[2]);
+        }
+        local.tested += uint64_t(std::max<int64_t>(0, to - from + 1));
+      }
+    }
+  };
+
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nBounded, 256), [&](const tbb::blocked_range<size_t>& r) {
+    if (cancelled.load(std::memory_order_relaxed)) return;
+    Local& local = locals.local();
+    for (size_t id = r.begin(); id != r.end(); ++id) voxelizePrimitive(id, local);
+    const size_t finished = done.fetch_add(r.size()) + r.size();
+    if (options.progress && !options.progress(0.9 * double(finished) / double(nBounded))) cancelled = true;
+  });
+  if (cancelled) fail<Error>("voxelization cancelled");
+
+  // Gather the references of all threads and group them by cell.
+  VoxelizeStats local{};
+  size_t total = 0;
+  for (auto& l : locals) {
+    total += packed ? l.packedRefs.size() : l.pairRefs.size();
+    local.cellsTested += l.tested;
+    local.exactFallbacks += l.fallbacks;
+    local.degenerateTriangles += l.degenerate;
+    grid.outsidePrims.insert(grid.outsidePrims.end(), l.outside.begin(), l.outside.end());
+  }
+  std::sort(grid.outsidePrims.begin(), grid.outsidePrims.end());
+  grid.primIds.reserve(total);
+  grid.cellKeys.clear();
+  grid.cellStart.clear();
+  auto appendRef = [&](uint64_t key, uint32_t prim) {
+    if (grid.cellKeys.empty() || grid.cellKeys.back() != key) {
+      grid.cellKeys.push_back(key);
+      grid.cellStart.push_back(grid.primIds.size());
+    }
+    grid.primIds.push_back(prim);
+  };
+  if (packed) {
+    std::vector<uint64_t> all;
+    all.reserve(total);
+    for (auto& l : locals) {
+      all.insert(all.end(), l.packedRefs.begin(), l.packedRefs.end());
+      std::vector<uint64_t>().swap(l.packedRefs);
+    }
+    radixSort(all, primBits + keyBits);
+    for (uint64_t x : all) appendRef(x >> primBits, uint32_t(x & primMask));
+  } else {
+    std::vector<std::pair<uint64_t, uint32_t>> all;
+    all.reserve(total);
+    for (auto& l : locals) {
+      all.insert(all.end(), l.pairRefs.begin(), l.pairRefs.end());
+      std::vector<std::pair<uint64_t, uint32_t>>().swap(l.pairRefs);
+    }
+    tbb::parallel_sort(all.begin(), all.end());
+    for (const auto& [key, prim] : all) appendRef(key, prim);
+  }
+  grid.cellStart.push_back(grid.primIds.size());
+  if (options.progress) options.progress(1.0);
+  local.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (stats) *stats = local;
+  return grid;
+}
+
+}  // namespace vox

@@ -1,18 +1,26 @@
-// Primary-ray throughput of the grid against Embree 3 on the same triangles, camera and thread count.
-//   bench_trace [--threads N] [--size N] [--reps N] [--factor F ...] [SCENE ...]
-// Default scenes: the 40k seed bunny, the 69k Stanford bunny (PLY), the 115k SheenCloth. For each scene it voxelizes
-// (exact) at each cells-per-triangle factor and traces size x size primary rays from defaultCamera(bounds) with
-// rtcIntersect1, rtcIntersect8 (coherent context, 4x2 pixel packets), vox::traceRay (one ray at a time) and
-// vox::tracePacket (8x8 pixel packets, as vox-trace renders). rtcIntersect1 and traceRay take the rays in the same
-// order as the packets, tile after tile. The methods take turns, `reps` rounds, and each keeps
-// its best time, so that a burst of load on a shared machine hits them alike. Prints rays per second, the ratios
+// Ray throughput of the grid against Embree 3 on the same triangles, rays and thread count.
+//   bench_trace [--threads N] [--size N] [--reps N] [--factor F ...] [--incoherent] [SCENE ...]
+// Default scenes: the 40k seed bunny, the 69k Stanford bunny (PLY), the 115k SheenCloth.
+// Primary rays (default): for each scene it voxelizes (exact) at each cells-per-triangle factor and traces size x size
+// primary rays from defaultCamera(bounds) with rtcIntersect1, rtcIntersect8 (coherent context, 4x2 pixel packets),
+// vox::traceRay (one ray at a time) and vox::tracePacket (8x8 pixel packets, as vox-trace renders). rtcIntersect1 and
+// traceRay take the rays in the same order as the packets, tile after tile. Prints rays per second, the ratios
 // ours / Embree, cells and tests per ray, and how many pixels hit the same triangle as Embree and as traceRay.
+// Incoherent rays (--incoherent, issue 12): secondary rays from the first hits of those primary rays, on the grid
+// vox-voxelize makes by default (planGrid): reflection, cosine-weighted hemisphere rays (closest hit, unbounded),
+// ambient-occlusion rays (the same directions, occlusion within a radius) and shadow rays to a point light, through
+// rtcIntersect1 / rtcOccluded1 and vox::traceRay / vox::occluded. Outside the timed runs, every ray's result is
+// compared with Embree's (same triangle, or t within float tolerance; same occluded flag) and a sample with the
+// brute force (--accel none), bit for bit.
+// The methods take turns, `reps` rounds, so that a burst of load on a shared machine hits them alike; each keeps its
+// best and median time.
 #include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -21,6 +29,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "vox/trace/accel.h"
@@ -35,9 +44,17 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 struct Method {
+  Method(std::string n, std::function<void()> r) : name(std::move(n)), run(std::move(r)) {}
   std::string name;
   std::function<void()> run;
   double best = 1e30;
+  std::vector<double> times;
+
+  double median() const {
+    std::vector<double> t = times;
+    std::sort(t.begin(), t.end());
+    return t.empty() ? 0 : t.size() % 2 ? t[t.size() / 2] : (t[t.size() / 2 - 1] + t[t.size() / 2]) / 2;
+  }
 };
 
 void timeInTurns(std::vector<Method>& methods, int reps) {
@@ -45,9 +62,45 @@ void timeInTurns(std::vector<Method>& methods, int reps) {
     for (Method& m : methods) {
       const auto t0 = Clock::now();
       m.run();
-      m.best = std::min(m.best, std::chrono::duration<double>(Clock::now() - t0).count());
+      const double t = std::chrono::duration<double>(Clock::now() - t0).count();
+      m.best = std::min(m.best, t);
+      m.times.push_back(t);
     }
 }
+
+// The scene's triangles as floats in an Embree scene: one geometry, primID = our triangle id.
+struct EmbreeScene {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+
+  EmbreeScene(const vox::Scene& s, unsigned threads) {
+    const std::string config = "threads=" + std::to_string(threads);
+    device = rtcNewDevice(config.c_str());
+    scene = rtcNewScene(device);
+    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    const size_t nt = s.triangles.size();
+    auto* vb = static_cast<float*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * nt));
+    auto* ib = static_cast<unsigned*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), nt));
+    for (size_t t = 0; t < nt; ++t)
+      for (int k = 0; k < 3; ++k) {
+        const vox::Vec3& v = s.triangles[t].v[k];
+        vb[9 * t + 3 * k] = float(v.x), vb[9 * t + 3 * k + 1] = float(v.y), vb[9 * t + 3 * k + 2] = float(v.z);
+        ib[3 * t + k] = unsigned(3 * t + k);
+      }
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(scene, geom);
+    rtcReleaseGeometry(geom);
+    rtcCommitScene(scene);
+  }
+  ~EmbreeScene() {
+    rtcReleaseScene(scene);
+    rtcReleaseDevice(device);
+  }
+  EmbreeScene(const EmbreeScene&) = delete;
+  EmbreeScene& operator=(const EmbreeScene&) = delete;
+};
 
 // The rays in the order vox-trace makes them: 8x8 pixel tiles, tile after tile (pixel[i] is the pixel of ray i).
 struct TiledRays {
@@ -85,6 +138,310 @@ std::array<uint32_t, 3> dimsForFactor(const vox::Box& b, size_t triangles, doubl
   return d;
 }
 
+// Primary rays at each cells-per-triangle factor (the table of README's Tracing paragraph).
+void benchPrimary(const std::string& path, unsigned threads, uint32_t size, int reps, const std::vector<double>& factors) {
+  const vox::Scene scene = vox::loadScene(path);
+  const vox::Box bounds = *vox::sceneBounds(scene);
+  const vox::Camera cam = vox::defaultCamera(bounds);
+  const uint64_t rayCount = uint64_t(size) * size;
+  std::vector<vox::Ray> rays(rayCount);
+  for (uint32_t y = 0; y < size; ++y)
+    for (uint32_t x = 0; x < size; ++x) rays[uint64_t(y) * size + x] = vox::primaryRay(cam, size, size, x + 0.5, y + 0.5);
+
+  // Embree: the same triangles as floats.
+  const EmbreeScene embree(scene, threads);
+  const RTCScene es = embree.scene;
+  const size_t nt = scene.triangles.size();
+
+  const TiledRays tiled = tileRays(rays, size);
+  const size_t tileCount = tiled.tileStart.size() - 1;
+  std::vector<Method> methods;
+  std::vector<unsigned> embreeHit(rayCount);
+  methods.push_back({"embree rtcIntersect1", [&] {
+    tbb::parallel_for(tbb::blocked_range<uint64_t>(0, rayCount, 1024), [&](const tbb::blocked_range<uint64_t>& r) {
+      RTCIntersectContext ctx;
+      rtcInitIntersectContext(&ctx);
+      for (uint64_t i = r.begin(); i < r.end(); ++i) {
+        const vox::Ray& ray = tiled.rays[i];
+        RTCRayHit rh{};
+        rh.ray.org_x = float(ray.origin.x), rh.ray.org_y = float(ray.origin.y), rh.ray.org_z = float(ray.origin.z);
+        rh.ray.dir_x = float(ray.direction.x), rh.ray.dir_y = float(ray.direction.y), rh.ray.dir_z = float(ray.direction.z);
+        rh.ray.tnear = 0, rh.ray.tfar = INFINITY, rh.ray.mask = unsigned(-1);
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(es, &ctx, &rh);
+        embreeHit[tiled.pixel[i]] = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? vox::kNoPrim : rh.hit.primID;
+      }
+    });
+  }});
+  // Packets of 8: 4x2 pixel blocks, coherent context.
+  methods.push_back({"embree rtcIntersect8 coherent", [&] {
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, size / 2), [&](const tbb::blocked_range<uint32_t>& rows) {
+      RTCIntersectContext ctx;
+      rtcInitIntersectContext(&ctx);
+      ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+      alignas(32) RTCRayHit8 rh;
+      alignas(32) int valid[8];
+      for (uint32_t by = rows.begin(); by < rows.end(); ++by)
+        for (uint32_t bx = 0; bx + 4 <= size; bx += 4) {
+          for (int k = 0; k < 8; ++k) {
+            const vox::Ray& ray = rays[uint64_t(2 * by + k / 4) * size + bx + k % 4];
+            valid[k] = -1;
+            rh.ray.org_x[k] = float(ray.origin.x), rh.ray.org_y[k] = float(ray.origin.y), rh.ray.org_z[k] = float(ray.origin.z);
+            rh.ray.dir_x[k] = float(ray.direction.x), rh.ray.dir_y[k] = float(ray.direction.y), rh.ray.dir_z[k] = float(ray.direction.z);
+            rh.ray.tnear[k] = 0, rh.ray.tfar[k] = INFINITY, rh.ray.mask[k] = unsigned(-1), rh.ray.time[k] = 0, rh.ray.flags[k] = 0;
+            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+          }
+          rtcIntersect8(valid, es, &ctx, &rh);
+        }
+    });
+  }});
+
+  struct Variant {
+    std::unique_ptr<vox::Grid> grid;
+    std::unique_ptr<vox::Accel> accel;
+    double factor = 0, voxelizeSeconds = 0;
+    std::vector<uint32_t> single;
+    std::vector<vox::Hit> packet;
+  };
+  std::vector<Variant> variants(factors.size());
+  for (size_t f = 0; f < factors.size(); ++f) {
+    Variant& v = variants[f];
+    v.factor = factors[f];
+    vox::VoxelizeOptions vo;
+    vo.dims = dimsForFactor(bounds, nt, v.factor);
+    const auto v0 = Clock::now();
+    v.grid = std::make_unique<vox::Grid>(vox::voxelizeScene(scene, vo));
+    v.voxelizeSeconds = std::chrono::duration<double>(Clock::now() - v0).count();
+    v.accel = std::make_unique<vox::Accel>(vox::buildAccel(scene, *v.grid, vox::AccelKind::Grid));
+    v.single.resize(rayCount);
+    v.packet.resize(rayCount);
+    methods.push_back({"grid traceRay", [&v, &tiled, rayCount] {
+      tbb::parallel_for(tbb::blocked_range<uint64_t>(0, rayCount, 1024), [&](const tbb::blocked_range<uint64_t>& r) {
+        for (uint64_t i = r.begin(); i < r.end(); ++i) v.single[tiled.pixel[i]] = vox::traceRay(*v.accel, tiled.rays[i]).prim;
+      });
+    }});
+    methods.push_back({"grid tracePacket", [&v, &tiled, tileCount] {
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, tileCount, 16), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t tile = r.begin(); tile < r.end(); ++tile) tracePackets(*v.accel, tiled, tile, v.packet.data(), nullptr);
+      });
+    }});
+  }
+  timeInTurns(methods, reps);
+
+  const double e1 = methods[0].best, e8 = methods[1].best;
+  const char* name = std::strrchr(path.c_str(), '/') ? std::strrchr(path.c_str(), '/') + 1 : path.c_str();
+  std::printf("\n%s: %zu triangles\n", name, nt);
+  std::printf("  embree rtcIntersect1:            %8.2f Mrays/s\n", rayCount / e1 / 1e6);
+  std::printf("  embree rtcIntersect8 coherent:   %8.2f Mrays/s\n", rayCount / e8 / 1e6);
+  for (size_t f = 0; f < variants.size(); ++f) {
+    const Variant& v = variants[f];
+    const double g = methods[2 + 2 * f].best, gp = methods[3 + 2 * f].best;
+    vox::TraceStats st, pst;
+    for (uint64_t i = 0; i < rayCount; i += 97) vox::traceRay(*v.accel, rays[i], &st);
+    std::vector<vox::Hit> scratch(rayCount);
+    for (size_t tile = 0; tile < tileCount; tile += 7) tracePackets(*v.accel, tiled, tile, scratch.data(), &pst);
+    uint64_t same = 0, packetSame = 0, hits = 0;
+    for (uint64_t i = 0; i < rayCount; ++i) {
+      same += v.single[i] == embreeHit[i];
+      packetSame += v.packet[i].prim == v.single[tiled.pixel[i]];
+      hits += v.single[i] != vox::kNoPrim;
+    }
+    std::printf("  grid %4ux%4ux%4u (%.1f cells/tri, voxelize %.2f s), %.1f%% of rays hit\n", v.grid->dims[0],
+                v.grid->dims[1], v.grid->dims[2], v.factor, v.voxelizeSeconds, 100.0 * hits / rayCount);
+    std::printf("    traceRay:    %8.2f Mrays/s  ratio vs rtcIntersect1 %.3f, vs rtcIntersect8 %.3f  cells/ray %.2f "
+                "tests/ray %.2f  same prim as embree %.3f%%\n",
+                rayCount / g / 1e6, e1 / g, e8 / g, double(st.cells) / st.rays, double(st.tests) / st.rays,
+                100.0 * same / rayCount);
+    std::printf("    tracePacket: %8.2f Mrays/s  ratio vs rtcIntersect1 %.3f, vs rtcIntersect8 %.3f  cells/ray %.2f "
+                "tests/ray %.2f  same prim as traceRay %.3f%%\n",
+                rayCount / gp / 1e6, e1 / gp, e8 / gp, double(pst.cells) / pst.rays, double(pst.tests) / pst.rays,
+                100.0 * packetSame / rayCount);
+    std::fflush(stdout);
+  }
+}
+
+// ---- Incoherent rays (issue 12) ----
+
+// SplitMix64 (Steele et al. 2014): a deterministic stream per ray, so the ray sets do not depend on threads.
+struct SplitMix {
+  uint64_t s;
+  uint64_t next() {
+    uint64_t z = (s += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+  }
+  double uniform() { return double(next() >> 11) * 0x1.0p-53; }
+};
+
+// One set of secondary rays; `occlusion` sets are any-hit queries (rtcOccluded1 / vox::occluded).
+struct RaySet {
+  std::string name;
+  bool occlusion = false;
+  std::vector<vox::Ray> rays;
+};
+
+// Cosine-weighted direction about the unit normal n (Malley's method), unit length.
+vox::Vec3 hemisphereDirection(const vox::Vec3& n, SplitMix& rng) {
+  const vox::Vec3 helper = std::fabs(n.x) > 0.5 ? vox::Vec3{0, 1, 0} : vox::Vec3{1, 0, 0};
+  const vox::Vec3 u = vox::normalize(vox::cross(helper, n)), v = vox::cross(n, u);
+  const double r = std::sqrt(rng.uniform()), phi = 2 * M_PI * rng.uniform();
+  const double h = std::sqrt(std::max(0.0, 1 - r * r));
+  return vox::normalize(u * (r * std::cos(phi)) + v * (r * std::sin(phi)) + n * h);
+}
+
+// Secondary rays from the first hits of `primary` (traced with traceRay): for every hit, one reflection ray, one
+// hemisphere ray (closest hit, unbounded), one ambient-occlusion ray (the same direction, occlusion within a fifth of
+// the bounds' diagonal) and one shadow ray to a point light above and beside the bounds. Origins are lifted off the
+// surface by 1e-5 of the diagonal along the normal facing the incoming ray, far above float rounding at these
+// scales, so that neither tracer hits the surface it starts from.
+std::vector<RaySet> secondaryRays(const vox::Accel& accel, const std::vector<vox::Ray>& primary, const vox::Box& b) {
+  std::vector<RaySet> sets = {{"reflection", false, {}}, {"hemisphere", false, {}}, {"ao", true, {}},
+                              {"shadow", true, {}}};
+  const vox::Vec3 extent = b.hi - b.lo, centre = (b.lo + b.hi) * 0.5;
+  const double diag = vox::length(extent), lift = 1e-5 * diag;
+  const vox::Vec3 light = centre + vox::Vec3{0.6, 1.4, 0.9} * diag;
+  for (size_t i = 0; i < primary.size(); ++i) {
+    const vox::Ray& ray = primary[i];
+    const vox::Hit hit = vox::traceRay(accel, ray);
+    if (!hit.valid() || hit.prim >= accel.triangleCount) continue;
+    const vox::Vec3 d = vox::normalize(ray.direction);
+    vox::Vec3 n = vox::triangleNormal(accel.triangles[hit.prim]);
+    if (vox::dot(n, d) > 0) n = -n;
+    const vox::Vec3 o = ray.origin + ray.direction * hit.t + n * lift;
+    SplitMix rng{0x5eedull * (i + 1)};
+    const vox::Vec3 h = hemisphereDirection(n, rng);
+    sets[0].rays.push_back({o, d - n * (2 * vox::dot(d, n)), 0, vox::kInfinity});
+    sets[1].rays.push_back({o, h, 0, vox::kInfinity});
+    sets[2].rays.push_back({o, h, 0, 0.2 * diag});
+    sets[3].rays.push_back({o, light - o, 0, 1});
+  }
+  return sets;
+}
+
+// Embree's answer for ray i of a set: t (INFINITY on a miss) and primID, or the occluded flag as t = 0 / INFINITY.
+struct EmbreeResult {
+  float t = INFINITY;
+  unsigned prim = vox::kNoPrim;
+};
+void embreeTrace(RTCScene es, const RaySet& set, std::vector<EmbreeResult>& out) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, set.rays.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      const vox::Ray& ray = set.rays[i];
+      RTCRayHit rh{};
+      rh.ray.org_x = float(ray.origin.x), rh.ray.org_y = float(ray.origin.y), rh.ray.org_z = float(ray.origin.z);
+      rh.ray.dir_x = float(ray.direction.x), rh.ray.dir_y = float(ray.direction.y), rh.ray.dir_z = float(ray.direction.z);
+      rh.ray.tnear = float(ray.tMin), rh.ray.tfar = float(ray.tMax), rh.ray.mask = unsigned(-1);
+      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      if (set.occlusion) {
+        rtcOccluded1(es, &ctx, &rh.ray);
+        out[i] = {rh.ray.tfar < 0 ? 0.0f : INFINITY, vox::kNoPrim};
+      } else {
+        rtcIntersect1(es, &ctx, &rh);
+        if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) out[i] = {rh.ray.tfar, rh.hit.primID};
+        else out[i] = {};
+      }
+    }
+  });
+}
+
+// Ours, one ray at a time: vox::traceRay or vox::occluded (t = 0 / INFINITY for the flag).
+void voxTrace(const vox::Accel& accel, const RaySet& set, std::vector<vox::Hit>& out) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, set.rays.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      if (set.occlusion) out[i] = vox::occluded(accel, set.rays[i]) ? vox::Hit{0, 0} : vox::Hit{};
+      else out[i] = vox::traceRay(accel, set.rays[i]);
+    }
+  });
+}
+
+// How our results compare with Embree's: the same triangle (or both miss, or the same occluded flag), a different
+// triangle at a t within float tolerance (coincident or adjacent surfaces, an edge hit), or a mismatch.
+struct Agreement {
+  uint64_t same = 0, closeT = 0, mismatch = 0;
+};
+Agreement compareWithEmbree(const RaySet& set, const std::vector<vox::Hit>& ours, const std::vector<EmbreeResult>& e,
+                            double diag) {
+  Agreement a;
+  for (size_t i = 0; i < ours.size(); ++i) {
+    const bool oursHit = ours[i].valid(), embreeHit = std::isfinite(e[i].t);
+    if (set.occlusion || !oursHit || !embreeHit) {
+      (oursHit == embreeHit ? a.same : a.mismatch)++;
+    } else if (ours[i].prim == e[i].prim) {
+      ++a.same;
+    } else {
+      // Embree works in float: its t carries a relative error of a few float ulps of the coordinates.
+      const double len = vox::length(set.rays[i].direction);
+      const double tol = 1e-5 * diag / len + 1e-5 * ours[i].t;
+      (std::fabs(double(e[i].t) - ours[i].t) <= tol ? a.closeT : a.mismatch)++;
+    }
+  }
+  return a;
+}
+
+// Every `stride`-th ray against the brute force (every primitive tested): t and primitive bit for bit.
+uint64_t bruteForceDifferences(const vox::Accel& brute, const RaySet& set, const std::vector<vox::Hit>& ours,
+                               size_t stride, uint64_t& checked) {
+  std::atomic<uint64_t> diff{0}, count{0};
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, set.rays.size() / stride), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t k = r.begin(); k < r.end(); ++k) {
+      const size_t i = k * stride;
+      ++count;
+      if (set.occlusion) {
+        if (vox::occluded(brute, set.rays[i]) != ours[i].valid()) ++diff;
+      } else {
+        const vox::Hit h = vox::traceRay(brute, set.rays[i]);
+        if (h.prim != ours[i].prim || std::memcmp(&h.t, &ours[i].t, sizeof(double)) != 0) ++diff;
+      }
+    }
+  });
+  checked = count;
+  return diff;
+}
+
+// Secondary rays of one scene on its default grid: Embree against ours, same rays, results checked.
+void benchIncoherent(const std::string& path, unsigned threads, uint32_t size, int reps) {
+  const vox::Scene scene = vox::loadScene(path);
+  const vox::Box bounds = *vox::sceneBounds(scene);
+  const vox::Camera cam = vox::defaultCamera(bounds);
+  std::vector<vox::Ray> primary(uint64_t(size) * size);
+  for (uint32_t y = 0; y < size; ++y)
+    for (uint32_t x = 0; x < size; ++x)
+      primary[uint64_t(y) * size + x] = vox::primaryRay(cam, size, size, x + 0.5, y + 0.5);
+  const vox::Grid grid = vox::voxelizeScene(scene, vox::VoxelizeOptions{});  // vox-voxelize's default grid
+  const vox::Accel accel = vox::buildAccel(scene, grid, vox::AccelKind::Grid);
+  const vox::Accel brute = vox::buildAccel(scene, grid, vox::AccelKind::None);
+  const std::vector<RaySet> sets = secondaryRays(accel, tileRays(primary, size).rays, bounds);
+  const EmbreeScene embree(scene, threads);
+  const double diag = vox::length(bounds.hi - bounds.lo);
+
+  const char* name = std::strrchr(path.c_str(), '/') ? std::strrchr(path.c_str(), '/') + 1 : path.c_str();
+  std::printf("\n%s: %zu triangles, default grid %ux%ux%u, %zu secondary rays per set\n", name,
+              scene.triangles.size(), grid.dims[0], grid.dims[1], grid.dims[2], sets[0].rays.size());
+  std::printf("  %-11s %10s %10s %12s %12s %8s %9s %9s %9s %s\n", "set", "query", "embree", "ours", "ours/embree",
+              "(best)", "same", "close t", "mismatch", "brute force (diff/checked)");
+  for (const RaySet& set : sets) {
+    std::vector<EmbreeResult> e(set.rays.size());
+    std::vector<vox::Hit> ours(set.rays.size());
+    std::vector<Method> methods;
+    methods.push_back({"embree", [&] { embreeTrace(embree.scene, set, e); }});
+    methods.push_back({"ours", [&] { voxTrace(accel, set, ours); }});
+    timeInTurns(methods, reps);
+    const Agreement a = compareWithEmbree(set, ours, e, diag);
+    uint64_t checked = 0;
+    const uint64_t bruteDiff = bruteForceDifferences(brute, set, ours, std::max<size_t>(1, set.rays.size() / 500), checked);
+    const double n = double(set.rays.size());
+    std::printf("  %-11s %10s %8.2f M %10.2f M %12.3f %8.3f %8.3f%% %8.3f%% %9llu %llu/%llu\n", set.name.c_str(),
+                set.occlusion ? "occluded" : "closest", n / methods[0].median() / 1e6, n / methods[1].median() / 1e6,
+                methods[0].median() / methods[1].median(), methods[0].best / methods[1].best, 100.0 * a.same / n,
+                100.0 * a.closeT / n, (unsigned long long)a.mismatch, (unsigned long long)bruteDiff,
+                (unsigned long long)checked);
+    std::fflush(stdout);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -93,156 +450,32 @@ int main(int argc, char** argv) {
   int reps = 7;
   std::vector<double> factors;
   std::vector<std::string> scenes;
+  bool incoherent = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--threads" && i + 1 < argc) threads = unsigned(std::atoi(argv[++i]));
     else if (a == "--size" && i + 1 < argc) size = uint32_t(std::atoi(argv[++i]));
     else if (a == "--reps" && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
     else if (a == "--factor" && i + 1 < argc) factors.push_back(std::atof(argv[++i]));
+    else if (a == "--incoherent") incoherent = true;
     else scenes.push_back(a);
   }
   if (factors.empty()) factors = {0.5, 1, 2, 3};
+  // The incoherent sets read SheenCloth from its glTF sample (issue 12), the primary table from its OBJ copy.
+  const std::string cloth = incoherent ? "/gltf/SheenCloth/glTF/SheenCloth.gltf" : "/meshes/derived/sheencloth_115k.obj";
   if (scenes.empty())
     scenes = {std::string(VOX_SEED_DIR) + "/6837/scenes/bunny_40k.obj", std::string(VOX_SEED_DIR) + "/meshes/bun_zipper.ply",
-              std::string(VOX_SEED_DIR) + "/meshes/derived/sheencloth_115k.obj"};
+              std::string(VOX_SEED_DIR) + cloth};
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
-  std::printf("threads: %u, image: %ux%u primary rays, best of %d rounds taken in turns\n", threads, size, size, reps);
+  if (incoherent)
+    std::printf("threads: %u, secondary rays from the hits of %ux%u primary rays, Mrays/s of the median of %d rounds "
+                "taken in turns (best: ratio of best times)\n", threads, size, size, reps);
+  else
+    std::printf("threads: %u, image: %ux%u primary rays, best of %d rounds taken in turns\n", threads, size, size, reps);
 
   for (const std::string& path : scenes) {
-    const vox::Scene scene = vox::loadScene(path);
-    const vox::Box bounds = *vox::sceneBounds(scene);
-    const vox::Camera cam = vox::defaultCamera(bounds);
-    const uint64_t rayCount = uint64_t(size) * size;
-    std::vector<vox::Ray> rays(rayCount);
-    for (uint32_t y = 0; y < size; ++y)
-      for (uint32_t x = 0; x < size; ++x) rays[uint64_t(y) * size + x] = vox::primaryRay(cam, size, size, x + 0.5, y + 0.5);
-
-    // Embree: the same triangles as floats.
-    const std::string config = "threads=" + std::to_string(threads);
-    RTCDevice device = rtcNewDevice(config.c_str());
-    RTCScene es = rtcNewScene(device);
-    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    const size_t nt = scene.triangles.size();
-    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * nt));
-    auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), nt));
-    for (size_t t = 0; t < nt; ++t)
-      for (int k = 0; k < 3; ++k) {
-        const vox::Vec3& v = scene.triangles[t].v[k];
-        vb[9 * t + 3 * k] = float(v.x), vb[9 * t + 3 * k + 1] = float(v.y), vb[9 * t + 3 * k + 2] = float(v.z);
-        ib[3 * t + k] = unsigned(3 * t + k);
-      }
-    rtcCommitGeometry(geom);
-    rtcAttachGeometry(es, geom);
-    rtcReleaseGeometry(geom);
-    rtcCommitScene(es);
-
-    const TiledRays tiled = tileRays(rays, size);
-    const size_t tileCount = tiled.tileStart.size() - 1;
-    std::vector<Method> methods;
-    std::vector<unsigned> embreeHit(rayCount);
-    methods.push_back({"embree rtcIntersect1", [&] {
-      tbb::parallel_for(tbb::blocked_range<uint64_t>(0, rayCount, 1024), [&](const tbb::blocked_range<uint64_t>& r) {
-        RTCIntersectContext ctx;
-        rtcInitIntersectContext(&ctx);
-        for (uint64_t i = r.begin(); i < r.end(); ++i) {
-          const vox::Ray& ray = tiled.rays[i];
-          RTCRayHit rh{};
-          rh.ray.org_x = float(ray.origin.x), rh.ray.org_y = float(ray.origin.y), rh.ray.org_z = float(ray.origin.z);
-          rh.ray.dir_x = float(ray.direction.x), rh.ray.dir_y = float(ray.direction.y), rh.ray.dir_z = float(ray.direction.z);
-          rh.ray.tnear = 0, rh.ray.tfar = INFINITY, rh.ray.mask = unsigned(-1);
-          rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-          rtcIntersect1(es, &ctx, &rh);
-          embreeHit[tiled.pixel[i]] = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? vox::kNoPrim : rh.hit.primID;
-        }
-      });
-    }});
-    // Packets of 8: 4x2 pixel blocks, coherent context.
-    methods.push_back({"embree rtcIntersect8 coherent", [&] {
-      tbb::parallel_for(tbb::blocked_range<uint32_t>(0, size / 2), [&](const tbb::blocked_range<uint32_t>& rows) {
-        RTCIntersectContext ctx;
-        rtcInitIntersectContext(&ctx);
-        ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-        alignas(32) RTCRayHit8 rh;
-        alignas(32) int valid[8];
-        for (uint32_t by = rows.begin(); by < rows.end(); ++by)
-          for (uint32_t bx = 0; bx + 4 <= size; bx += 4) {
-            for (int k = 0; k < 8; ++k) {
-              const vox::Ray& ray = rays[uint64_t(2 * by + k / 4) * size + bx + k % 4];
-              valid[k] = -1;
-              rh.ray.org_x[k] = float(ray.origin.x), rh.ray.org_y[k] = float(ray.origin.y), rh.ray.org_z[k] = float(ray.origin.z);
-              rh.ray.dir_x[k] = float(ray.direction.x), rh.ray.dir_y[k] = float(ray.direction.y), rh.ray.dir_z[k] = float(ray.direction.z);
-              rh.ray.tnear[k] = 0, rh.ray.tfar[k] = INFINITY, rh.ray.mask[k] = unsigned(-1), rh.ray.time[k] = 0, rh.ray.flags[k] = 0;
-              rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-            }
-            rtcIntersect8(valid, es, &ctx, &rh);
-          }
-      });
-    }});
-
-    struct Variant {
-      std::unique_ptr<vox::Grid> grid;
-      std::unique_ptr<vox::Accel> accel;
-      double factor = 0, voxelizeSeconds = 0;
-      std::vector<uint32_t> single;
-      std::vector<vox::Hit> packet;
-    };
-    std::vector<Variant> variants(factors.size());
-    for (size_t f = 0; f < factors.size(); ++f) {
-      Variant& v = variants[f];
-      v.factor = factors[f];
-      vox::VoxelizeOptions vo;
-      vo.dims = dimsForFactor(bounds, nt, v.factor);
-      const auto v0 = Clock::now();
-      v.grid = std::make_unique<vox::Grid>(vox::voxelizeScene(scene, vo));
-      v.voxelizeSeconds = std::chrono::duration<double>(Clock::now() - v0).count();
-      v.accel = std::make_unique<vox::Accel>(vox::buildAccel(scene, *v.grid, vox::AccelKind::Grid));
-      v.single.resize(rayCount);
-      v.packet.resize(rayCount);
-      methods.push_back({"grid traceRay", [&v, &tiled, rayCount] {
-        tbb::parallel_for(tbb::blocked_range<uint64_t>(0, rayCount, 1024), [&](const tbb::blocked_range<uint64_t>& r) {
-          for (uint64_t i = r.begin(); i < r.end(); ++i) v.single[tiled.pixel[i]] = vox::traceRay(*v.accel, tiled.rays[i]).prim;
-        });
-      }});
-      methods.push_back({"grid tracePacket", [&v, &tiled, tileCount] {
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, tileCount, 16), [&](const tbb::blocked_range<size_t>& r) {
-          for (size_t tile = r.begin(); tile < r.end(); ++tile) tracePackets(*v.accel, tiled, tile, v.packet.data(), nullptr);
-        });
-      }});
-    }
-    timeInTurns(methods, reps);
-    rtcReleaseScene(es);
-    rtcReleaseDevice(device);
-
-    const double e1 = methods[0].best, e8 = methods[1].best;
-    const char* name = std::strrchr(path.c_str(), '/') ? std::strrchr(path.c_str(), '/') + 1 : path.c_str();
-    std::printf("\n%s: %zu triangles\n", name, nt);
-    std::printf("  embree rtcIntersect1:            %8.2f Mrays/s\n", rayCount / e1 / 1e6);
-    std::printf("  embree rtcIntersect8 coherent:   %8.2f Mrays/s\n", rayCount / e8 / 1e6);
-    for (size_t f = 0; f < variants.size(); ++f) {
-      const Variant& v = variants[f];
-      const double g = methods[2 + 2 * f].best, gp = methods[3 + 2 * f].best;
-      vox::TraceStats st, pst;
-      for (uint64_t i = 0; i < rayCount; i += 97) vox::traceRay(*v.accel, rays[i], &st);
-      std::vector<vox::Hit> scratch(rayCount);
-      for (size_t tile = 0; tile < tileCount; tile += 7) tracePackets(*v.accel, tiled, tile, scratch.data(), &pst);
-      uint64_t same = 0, packetSame = 0, hits = 0;
-      for (uint64_t i = 0; i < rayCount; ++i) {
-        same += v.single[i] == embreeHit[i];
-        packetSame += v.packet[i].prim == v.single[tiled.pixel[i]];
-        hits += v.single[i] != vox::kNoPrim;
-      }
-      std::printf("  grid %4ux%4ux%4u (%.1f cells/tri, voxelize %.2f s), %.1f%% of rays hit\n", v.grid->dims[0],
-                  v.grid->dims[1], v.grid->dims[2], v.factor, v.voxelizeSeconds, 100.0 * hits / rayCount);
-      std::printf("    traceRay:    %8.2f Mrays/s  ratio vs rtcIntersect1 %.3f, vs rtcIntersect8 %.3f  cells/ray %.2f "
-                  "tests/ray %.2f  same prim as embree %.3f%%\n",
-                  rayCount / g / 1e6, e1 / g, e8 / g, double(st.cells) / st.rays, double(st.tests) / st.rays,
-                  100.0 * same / rayCount);
-      std::printf("    tracePacket: %8.2f Mrays/s  ratio vs rtcIntersect1 %.3f, vs rtcIntersect8 %.3f  cells/ray %.2f "
-                  "tests/ray %.2f  same prim as traceRay %.3f%%\n",
-                  rayCount / gp / 1e6, e1 / gp, e8 / gp, double(pst.cells) / pst.rays, double(pst.tests) / pst.rays,
-                  100.0 * packetSame / rayCount);
-      std::fflush(stdout);
-    }
+    if (incoherent) benchIncoherent(path, threads, size, reps);
+    else benchPrimary(path, threads, size, reps, factors);
   }
   return 0;
 }

@@ -78,6 +78,25 @@ std::optional<CellRange> rangeOf(const Grid& grid, const Box& box) {
   return r;
 }
 
+// The part of a primitive's cell range inside a brick's window (the whole grid for a single grid).
+std::optional<CellRange> clip(std::optional<CellRange> r, const CellWindow& window) {
+  if (!r) return r;
+  for (int a = 0; a < 3; ++a) {
+    r->first[a] = std::max<int64_t>(r->first[a], window.first[a]);
+    r->last[a] = std::min<int64_t>(r->last[a], int64_t(window.end[a]) - 1);
+    if (r->first[a] > r->last[a]) return std::nullopt;
+  }
+  return r;
+}
+
+// The bounded primitive ids to voxelize: all of them (ids 0 .. count-1) or a brick's candidates.
+struct PrimitiveList {
+  const uint32_t* list = nullptr;  // null: the identity
+  size_t count = 0;
+  size_t size() const { return count; }
+  size_t operator[](size_t n) const { return list ? list[n] : n; }
+};
+
 bool inside(const Box& inner, const Box& outer) {
   for (int a = 0; a < 3; ++a)
     if (inner.lo[a] < outer.lo[a] || inner.hi[a] > outer.hi[a]) return false;
@@ -123,28 +142,37 @@ double triangleArea(const Triangle& t) { return 0.5 * length(cross(t.v[1] - t.v[
 
 // A generous estimate of the references a primitive makes: a surface of area A crosses at most about
 // 3 A / h^2 + 2 P / h + 8 cells of side h (h the smallest cell side), and never more than its bounding range.
-double estimateReferences(const Scene& scene, const Grid& grid) {
+double estimateReferences(const Scene& scene, const Grid& grid, const CellWindow& window, const PrimitiveList& ids) {
   double h = HUGE_VAL;
   for (int a = 0; a < 3; ++a) h = std::min(h, (grid.bounds.hi[a] - grid.bounds.lo[a]) / grid.dims[a]);
   double total = 0;
   // bbox takes the whole range; center takes the cells whose centres lie in the footprint, at most the range too.
   const bool wholeRange = grid.method == OverlapMethod::BBox || grid.method == OverlapMethod::Center;
   auto add = [&](const Box& box, double area, double perimeter) {
-    const auto r = rangeOf(grid, box);
+    const auto r = clip(rangeOf(grid, box), window);
     if (!r) return;
     const double range = double(r->count());
     total += wholeRange ? range : std::min(range, 3 * area / (h * h) + 2 * perimeter / h + 8);
   };
-  for (const auto& t : scene.triangles)
-    add(triangleBounds(t), triangleArea(t),
-        length(t.v[1] - t.v[0]) + length(t.v[2] - t.v[1]) + length(t.v[0] - t.v[2]));
-  for (const auto& s : scene.spheres) {
-    const Box b = sphereBounds(s);
-    const Vec3 e = (b.hi - b.lo) * 0.5;
-    add(b, 4 * M_PI * std::max({e.x * e.y, e.y * e.z, e.x * e.z}), 0);
+  const size_t nTri = scene.triangles.size();
+  for (size_t n = 0; n < ids.size(); ++n) {
+    const size_t id = ids[n];
+    if (id < nTri) {
+      const Triangle& t = scene.triangles[id];
+      add(triangleBounds(t), triangleArea(t),
+          length(t.v[1] - t.v[0]) + length(t.v[2] - t.v[1]) + length(t.v[0] - t.v[2]));
+    } else {
+      const Box b = sphereBounds(scene.spheres[id - nTri]);
+      const Vec3 e = (b.hi - b.lo) * 0.5;
+      add(b, 4 * M_PI * std::max({e.x * e.y, e.y * e.z, e.x * e.z}), 0);
+    }
   }
   return total;
 }
+
+struct PrimitiveList;
+void voxelizeWindow(const Scene& scene, Grid& grid, const CellWindow& window, const PrimitiveList& ids,
+                    const VoxelizeOptions& options, VoxelizeStats* stats);
 
 }  // namespace
 
@@ -213,15 +241,56 @@ Grid planGrid(const Scene& scene, const VoxelizeOptions& options) {
   return grid;
 }
 
+std::vector<uint32_t> primitivesOutside(const Scene& scene, const Grid& grid) {
+  std::vector<uint32_t> out;
+  const size_t nTri = scene.triangles.size(), nBounded = scene.boundedCount();
+  for (size_t id = 0; id < nBounded; ++id) {
+    const Box b = id < nTri ? triangleBounds(scene.triangles[id]) : sphereBounds(scene.spheres[id - nTri]);
+    if (!inside(b, grid.bounds)) out.push_back(uint32_t(id));
+  }
+  return out;
+}
+
 Grid voxelizeScene(const Scene& scene, const VoxelizeOptions& options, VoxelizeStats* stats) {
-  const auto start = std::chrono::steady_clock::now();
   Grid grid = planGrid(scene, options);
-  const size_t nTri = scene.triangles.size();
   const size_t nBounded = scene.boundedCount();
   if (nBounded == 0) return grid;
   if (nBounded > UINT32_MAX) fail<LimitError>("too many primitives (", nBounded, ")");
+  if (options.bounds) grid.outsidePrims = primitivesOutside(scene, grid);
+  voxelizeWindow(scene, grid, CellWindow{{0, 0, 0}, grid.dims}, PrimitiveList{nullptr, nBounded}, options, stats);
+  return grid;
+}
 
-  const double estimate = estimateReferences(scene, grid);
+Grid voxelizeBrick(const Scene& scene, const Grid& plan, const CellWindow& window, std::span<const uint32_t> ids,
+                   const VoxelizeOptions& options, VoxelizeStats* stats) {
+  Grid grid = plan;
+  grid.cellKeys.clear();
+  grid.cellStart.assign(1, 0);
+  grid.primIds.clear();
+  for (int a = 0; a < 3; ++a)
+    if (window.first[a] >= window.end[a] || window.end[a] > plan.dims[a])
+      fail<UsageError>("brick window outside the grid on axis ", "xyz"[a]);
+  if (scene.boundedCount() > UINT32_MAX) fail<LimitError>("too many primitives (", scene.boundedCount(), ")");
+  for (uint32_t id : ids)
+    if (id >= scene.boundedCount()) fail<UsageError>("brick candidate ", id, " is not a bounded primitive");
+  if (ids.empty()) return grid;
+  voxelizeWindow(scene, grid, window, PrimitiveList{ids.data(), ids.size()}, options, stats);
+  return grid;
+}
+
+namespace {
+
+// Voxelizes the primitives `ids` into the cells of `window` of the planned `grid`. A primitive's cell tests are the
+// same whatever the window (the filter's error bounds come from its whole cell range), so a brick gets exactly the
+// single grid's cells restricted to it, for every method.
+void voxelizeWindow(const Scene& scene, Grid& grid, const CellWindow& window, const PrimitiveList& ids,
+                    const VoxelizeOptions& options, VoxelizeStats* stats) {
+  const auto start = std::chrono::steady_clock::now();
+  const size_t nTri = scene.triangles.size();
+  const size_t nBounded = scene.boundedCount();
+  const size_t nWork = ids.size();
+
+  const double estimate = estimateReferences(scene, grid, window, ids);
   constexpr double kBytesPerReference = 44;  // packed entry, radix buffer, and the compressed cell lists
   if (estimate * kBytesPerReference > double(options.memoryLimitBytes))
     fail<LimitError>("grid ", grid.dims[0], "x", grid.dims[1], "x", grid.dims[2], " needs about ",
@@ -246,7 +315,6 @@ Grid voxelizeScene(const Scene& scene, const VoxelizeOptions& options, VoxelizeS
     std::vector<uint64_t> packedRefs;
     std::vector<std::pair<uint64_t, uint32_t>> pairRefs;
     uint64_t tested = 0, fallbacks = 0, degenerate = 0;
-    std::vector<uint32_t> outside;
   };
   tbb::enumerable_thread_specific<Local> locals;
   std::atomic<size_t> done{0};
@@ -264,8 +332,8 @@ Grid voxelizeScene(const Scene& scene, const VoxelizeOptions& options, VoxelizeS
     };
     const bool isTri = id < nTri;
     const Box primBox = isTri ? triangleBounds(scene.triangles[id]) : sphereBounds(scene.spheres[id - nTri]);
-    if (options.bounds && !inside(primBox, grid.bounds)) local.outside.push_back(uint32_t(id));
-    const auto range = rangeOf(grid, primBox);
+    const auto fullRange = rangeOf(grid, primBox);
+    const auto range = clip(fullRange, window);
     if (!range) return;
     const auto& [first, last] = *range;
     if (options.method == OverlapMethod::BBox) {
@@ -321,9 +389,10 @@ Grid voxelizeScene(const Scene& scene, const VoxelizeOptions& options, VoxelizeS
     {
       // |corner - origin| over every cell of the range, for the filter's error bounds (rounded up generously).
       double qMax[3];
+      // Over the whole range, not the brick's part of it: the same bounds give the same undecided cells.
       for (int ax = 0; ax < 3; ++ax)
-        qMax[ax] = 1.0000001 * std::max(std::fabs(boundary[ax][first[ax]] - filter.origin[ax]),
-                                        std::fabs(boundary[ax][last[ax] + 1] - filter.origin[ax]));
+        qMax[ax] = 1.0000001 * std::max(std::fabs(boundary[ax][fullRange->first[ax]] - filter.origin[ax]),
+                                        std::fabs(boundary[ax][fullRange->last[ax] + 1] - filter.origin[ax]));
       filter.prepare(qMax);
     }
     const bool sat = options.method == OverlapMethod::Sat;
@@ -369,12 +438,12 @@ Grid voxelizeScene(const Scene& scene, const VoxelizeOptions& options, VoxelizeS
     }
   };
 
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nBounded, 256), [&](const tbb::blocked_range<size_t>& r) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nWork, 256), [&](const tbb::blocked_range<size_t>& r) {
     if (cancelled.load(std::memory_order_relaxed)) return;
     Local& local = locals.local();
-    for (size_t id = r.begin(); id != r.end(); ++id) voxelizePrimitive(id, local);
+    for (size_t n = r.begin(); n != r.end(); ++n) voxelizePrimitive(ids[n], local);
     const size_t finished = done.fetch_add(r.size()) + r.size();
-    if (options.progress && !options.progress(0.9 * double(finished) / double(nBounded))) cancelled = true;
+    if (options.progress && !options.progress(0.9 * double(finished) / double(nWork))) cancelled = true;
   });
   if (cancelled) fail<Error>("voxelization cancelled");
 
@@ -386,9 +455,7 @@ Grid voxelizeScene(const Scene& scene, const VoxelizeOptions& options, VoxelizeS
     local.cellsTested += l.tested;
     local.exactFallbacks += l.fallbacks;
     local.degenerateTriangles += l.degenerate;
-    grid.outsidePrims.insert(grid.outsidePrims.end(), l.outside.begin(), l.outside.end());
   }
-  std::sort(grid.outsidePrims.begin(), grid.outsidePrims.end());
   grid.primIds.reserve(total);
   grid.cellKeys.clear();
   grid.cellStart.clear();
@@ -422,7 +489,8 @@ Grid voxelizeScene(const Scene& scene, const VoxelizeOptions& options, VoxelizeS
   if (options.progress) options.progress(1.0);
   local.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (stats) *stats = local;
-  return grid;
 }
+
+}  // namespace
 
 }  // namespace vox

@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <span>
+#include <vector>
 
 #include "vox/core/grid.h"
 #include "vox/core/scene.h"
@@ -42,6 +44,24 @@ Grid planGrid(const Scene& scene, const VoxelizeOptions& options);
 // Dimensions chosen by the default heuristic: about kCellsPerPrimitive cells per bounded primitive, cubic cells.
 std::array<uint32_t, 3> defaultDims(const Box& bounds, size_t boundedPrimitives);
 std::array<uint32_t, 3> dimsForResolution(const Box& bounds, uint32_t resolution);
+
+// A box of whole cells: first[a] <= i < end[a] on each axis a (a brick of a grid set).
+struct CellWindow {
+  std::array<uint32_t, 3> first{0, 0, 0};
+  std::array<uint32_t, 3> end{1, 1, 1};
+};
+
+// The bounded primitives whose bounding boxes stick out of grid.bounds, ascending (what voxelizeScene puts in
+// grid.outsidePrims when the bounds are the user's).
+std::vector<uint32_t> primitivesOutside(const Scene& scene, const Grid& grid);
+
+// One brick of a grid set: the cells of `window` of the grid `plan` (planGrid's result: its bounds, dims, method and
+// outsidePrims are kept, its cells ignored), holding exactly what voxelizeScene's grid holds in those cells, provided
+// `ids` (ascending bounded primitive ids) contains every primitive whose bounding box meets the window. Cell keys are
+// keys of the whole grid. Throws UsageError for a window outside the grid or an id that is not a bounded primitive,
+// LimitError as voxelizeScene (the estimate covers the window only).
+Grid voxelizeBrick(const Scene& scene, const Grid& plan, const CellWindow& window, std::span<const uint32_t> ids,
+                   const VoxelizeOptions& options, VoxelizeStats* stats = nullptr);
 
 // Voxelizes every bounded primitive of `scene`. Work is spread over the TBB arena of the caller.
 // Throws UsageError (bad options), LimitError (estimated memory over options.memoryLimitBytes, checked before the

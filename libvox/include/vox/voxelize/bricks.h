@@ -1,0 +1,30 @@
+// Bricks of a grid set (issue 13): how a grid's cells are split into boxes of whole cells, and which primitives
+// each box needs. No I/O.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "vox/core/grid.h"
+#include "vox/core/scene.h"
+#include "vox/voxelize/voxelize.h"
+
+namespace vox {
+
+// Cells of brick b on an axis of n cells split into B bricks: [floor(n b / B), floor(n (b + 1) / B)). Every brick
+// has at least one cell when 1 <= B <= n. Throws UsageError unless 1 <= bricks[a] <= dims[a] on every axis.
+void checkBrickCounts(const std::array<uint32_t, 3>& dims, const std::array<uint32_t, 3>& bricks);
+CellWindow brickWindow(const std::array<uint32_t, 3>& dims, const std::array<uint32_t, 3>& bricks,
+                       const std::array<uint32_t, 3>& index);
+// Linear brick number bx + BX (by + BY bz) and back.
+uint64_t brickNumber(const std::array<uint32_t, 3>& bricks, const std::array<uint32_t, 3>& index);
+std::array<uint32_t, 3> brickIndex(const std::array<uint32_t, 3>& bricks, uint64_t number);
+
+// For every brick (by brickNumber), the ascending ids of the bounded primitives whose cell range meets it: the
+// candidates voxelizeBrick needs. Throws LimitError (via memoryLimitBytes) before allocating when the lists would
+// not fit.
+std::vector<std::vector<uint32_t>> brickCandidates(const Scene& scene, const Grid& plan,
+                                                   const std::array<uint32_t, 3>& bricks, uint64_t memoryLimitBytes);
+
+}  // namespace vox

@@ -1,0 +1,87 @@
+#include "vox/voxelize/bricks.h"
+
+#include "vox/core/error.h"
+
+namespace vox {
+
+namespace {
+
+// A set lists its bricks and a tool keeps one candidate list per brick: beyond this many bricks that bookkeeping,
+// not the cells, would dominate memory.
+constexpr uint64_t kMaxBricks = uint64_t(1) << 24;
+
+// The brick holding cell c on an axis of n cells in B bricks: the largest b with floor(n b / B) <= c.
+uint32_t brickOfCell(uint64_t c, uint64_t n, uint64_t B) { return uint32_t(((c + 1) * B - 1) / n); }
+
+}  // namespace
+
+void checkBrickCounts(const std::array<uint32_t, 3>& dims, const std::array<uint32_t, 3>& bricks) {
+  for (int a = 0; a < 3; ++a)
+    if (bricks[a] == 0 || bricks[a] > dims[a])
+      fail<UsageError>("--bricks: ", bricks[a], " bricks on axis ", "xyz"[a], " of a grid ", dims[0], "x", dims[1],
+                       "x", dims[2], " (each brick needs at least one cell: 1 to ", dims[a], ")");
+  if (uint64_t(bricks[0]) * bricks[1] * bricks[2] > kMaxBricks)
+    fail<UsageError>("--bricks: ", bricks[0], "x", bricks[1], "x", bricks[2], " bricks, more than the ", kMaxBricks,
+                     " allowed");
+}
+
+CellWindow brickWindow(const std::array<uint32_t, 3>& dims, const std::array<uint32_t, 3>& bricks,
+                       const std::array<uint32_t, 3>& index) {
+  CellWindow w;
+  for (int a = 0; a < 3; ++a) {
+    VOX_CHECK(index[a] < bricks[a] && bricks[a] <= dims[a]);
+    w.first[a] = uint32_t(uint64_t(dims[a]) * index[a] / bricks[a]);
+    w.end[a] = uint32_t(uint64_t(dims[a]) * (index[a] + 1) / bricks[a]);
+  }
+  return w;
+}
+
+uint64_t brickNumber(const std::array<uint32_t, 3>& bricks, const std::array<uint32_t, 3>& index) {
+  return index[0] + uint64_t(bricks[0]) * (index[1] + uint64_t(bricks[1]) * index[2]);
+}
+
+std::array<uint32_t, 3> brickIndex(const std::array<uint32_t, 3>& bricks, uint64_t number) {
+  return {uint32_t(number % bricks[0]), uint32_t(number / bricks[0] % bricks[1]),
+          uint32_t(number / (uint64_t(bricks[0]) * bricks[1]))};
+}
+
+std::vector<std::vector<uint32_t>> brickCandidates(const Scene& scene, const Grid& plan,
+                                                   const std::array<uint32_t, 3>& bricks, uint64_t memoryLimitBytes) {
+  checkBrickCounts(plan.dims, bricks);
+  const size_t nTri = scene.triangles.size(), nBounded = scene.boundedCount();
+  // The bricks a primitive's cell range meets, per axis; empty when the range misses the grid.
+  auto brickRange = [&](size_t id, std::array<uint32_t, 3>& lo, std::array<uint32_t, 3>& hi) {
+    const Box box = id < nTri ? triangleBounds(scene.triangles[id]) : sphereBounds(scene.spheres[id - nTri]);
+    for (int a = 0; a < 3; ++a) {
+      const auto [f, l] = cellRange(plan.bounds, plan.dims, a, box.lo[a], box.hi[a]);
+      if (f > l) return false;
+      lo[a] = brickOfCell(uint64_t(f), plan.dims[a], bricks[a]);
+      hi[a] = brickOfCell(uint64_t(l), plan.dims[a], bricks[a]);
+    }
+    return true;
+  };
+  auto forEachBrick = [&](auto&& visit) {
+    std::array<uint32_t, 3> lo, hi;
+    for (size_t id = 0; id < nBounded; ++id) {
+      if (!brickRange(id, lo, hi)) continue;
+      for (uint32_t z = lo[2]; z <= hi[2]; ++z)
+        for (uint32_t y = lo[1]; y <= hi[1]; ++y)
+          for (uint32_t x = lo[0]; x <= hi[0]; ++x) visit(brickNumber(bricks, {x, y, z}), uint32_t(id));
+    }
+  };
+  // Counted first, so that a huge primitive over many small bricks is refused before the lists are made.
+  const uint64_t brickCount = uint64_t(bricks[0]) * bricks[1] * bricks[2];
+  std::vector<uint64_t> counts(brickCount, 0);
+  forEachBrick([&](uint64_t b, uint32_t) { ++counts[b]; });
+  double bytes = double(brickCount) * sizeof(std::vector<uint32_t>);
+  for (uint64_t c : counts) bytes += 4.0 * double(c);
+  if (bytes > double(memoryLimitBytes))
+    fail<LimitError>("the primitive lists of ", brickCount, " bricks need ", uint64_t(bytes / (1 << 20)),
+                     " MiB, more than the ", memoryLimitBytes >> 20, " MiB allowed");
+  std::vector<std::vector<uint32_t>> lists(brickCount);
+  for (uint64_t b = 0; b < brickCount; ++b) lists[b].reserve(counts[b]);
+  forEachBrick([&](uint64_t b, uint32_t id) { lists[b].push_back(id); });
+  return lists;
+}
+
+}  // namespace vox

@@ -4,13 +4,15 @@
 set -euo pipefail
 packages=(build-essential cmake ninja-build pkg-config python3
   libcgal-dev libopenmesh-dev libopenimageio-dev libtinygltf-dev libstb-dev nlohmann-json3-dev
-  libtbb-dev libcli11-dev libgtest-dev)
+  libtbb-dev libcli11-dev libgtest-dev
+  libopenvdb-dev)  # vox-export writes .vdb (export/vdb_writer.cpp)
 for arg in "$@"; do
   case $arg in
-    --bench) packages+=(libbenchmark-dev libembree-dev libopenvdb-dev) ;;
+    --bench) packages+=(libbenchmark-dev libembree-dev) ;;
     --meshlab) packages+=(meshlab xvfb xauth) ;;
     # Real clients of exported meshes (tests/cli/export_*.sh); numpy for Blender's glTF importer.
-    --clients) packages+=(meshlab xvfb xauth assimp-utils blender python3-numpy) ;;
+    # python3-openvdb (pyopenvdb) reads exported .vdb files back (tests/cli/export_voxel_formats.sh).
+    --clients) packages+=(meshlab xvfb xauth assimp-utils blender python3-numpy python3-openvdb) ;;
     --fuzz) packages+=(clang libclang-rt-14-dev) ;;  # libFuzzer and the sanitizer runtimes (scripts/fuzz.sh)
     *) echo "install-deps.sh: unknown option $arg" >&2; exit 1 ;;
   esac

@@ -113,20 +113,12 @@ uint32_t majorityMaterialColor(const Grid& grid, const Scene& scene, size_t cell
   return packColor(toRgb8(scene.materials[best.first].diffuse));
 }
 
-Voxels gatherVoxels(const Grid& grid, const Scene& scene, ColorMode mode) {
-  const uint64_t cellCount = grid.cellCount();
+// The packed colour of each occupied cell (kNoColor for ColorMode::None); shared by the meshes and by
+// occupiedCellColors (the voxel formats), so a cell has one colour in every export.
+std::vector<uint32_t> occupiedColors(const Grid& grid, const Scene& scene, ColorMode mode) {
   const size_t nOcc = grid.cellKeys.size();
   if (grid.cellStart.size() != nOcc + 1 || grid.cellStart.back() > grid.primIds.size())
     fail<InputError>("grid: inconsistent cell table (", nOcc, " cells, ", grid.cellStart.size(), " offsets)");
-  auto checkSorted = [&](const std::vector<uint64_t>& keys, const char* what) {
-    for (size_t i = 0; i < keys.size(); ++i) {
-      if (keys[i] >= cellCount) fail<InputError>("grid: ", what, " key ", keys[i], " outside the grid");
-      if (i > 0 && keys[i] <= keys[i - 1]) fail<InputError>("grid: ", what, " keys not sorted at index ", i);
-    }
-  };
-  checkSorted(grid.cellKeys, "cell");
-  checkSorted(grid.solidKeys, "solid cell");
-
   std::vector<uint32_t> occColor(nOcc, kNoColor);
   if (mode == ColorMode::Count) {
     uint32_t maxCount = 0;
@@ -148,6 +140,24 @@ Voxels gatherVoxels(const Grid& grid, const Scene& scene, ColorMode mode) {
     });
     if (error) std::rethrow_exception(error);
   }
+  return occColor;
+}
+
+Voxels gatherVoxels(const Grid& grid, const Scene& scene, ColorMode mode) {
+  const uint64_t cellCount = grid.cellCount();
+  const size_t nOcc = grid.cellKeys.size();
+  if (grid.cellStart.size() != nOcc + 1 || grid.cellStart.back() > grid.primIds.size())
+    fail<InputError>("grid: inconsistent cell table (", nOcc, " cells, ", grid.cellStart.size(), " offsets)");
+  auto checkSorted = [&](const std::vector<uint64_t>& keys, const char* what) {
+    for (size_t i = 0; i < keys.size(); ++i) {
+      if (keys[i] >= cellCount) fail<InputError>("grid: ", what, " key ", keys[i], " outside the grid");
+      if (i > 0 && keys[i] <= keys[i - 1]) fail<InputError>("grid: ", what, " keys not sorted at index ", i);
+    }
+  };
+  checkSorted(grid.cellKeys, "cell");
+  checkSorted(grid.solidKeys, "solid cell");
+
+  const std::vector<uint32_t> occColor = occupiedColors(grid, scene, mode);
 
   // Merge occupied and solid keys; a cell in both lists is drawn once, with its occupied colour.
   const uint32_t solid = mode == ColorMode::None ? kNoColor : packColor(kSolidCellColor);
@@ -996,6 +1006,14 @@ VoxelMesh triangulateVoxelMesh(const VoxelMesh& mesh) {
     }
   });
   return out;
+}
+
+std::vector<Rgb8> occupiedCellColors(const Grid& grid, const Scene& scene, ColorMode color) {
+  if (color == ColorMode::None) return {};
+  const std::vector<uint32_t> packed = occupiedColors(grid, scene, color);
+  std::vector<Rgb8> colors(packed.size());
+  for (size_t c = 0; c < packed.size(); ++c) colors[c] = unpackColor(packed[c]);
+  return colors;
 }
 
 }  // namespace vox

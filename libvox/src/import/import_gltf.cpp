@@ -8,8 +8,10 @@
 // - it does not enforce `extensionsRequired`, so KHR_materials_sheen or KHR_texture_transform listed as required
 //   do not stop loading; we only want geometry from them.
 // - node lights (KHR_lights_punctual) are not parsed into Node; we read node.extensions ourselves.
-// - image decoding is replaced by a no-op: textures are not used (base colour comes from the factor), and
-//   untrusted PNG/JPEG bytes then never reach stb_image.
+// - image decoding is replaced by keepImageBytes: stb_image never sees untrusted bytes; images named by uri (data or
+//   file) keep their encoded bytes in Image::image, and those in bufferViews are read by GltfReader with range
+//   checks (tinygltf hands the loader &buffer.data[byteOffset] without checking the view against the buffer).
+//   Only images that a material's baseColorTexture uses are decoded, by OpenImageIO (texture_decode.h).
 #define TINYGLTF_IMPLEMENTATION
 #define STB_IMAGE_IMPLEMENTATION
 #define STB_IMAGE_WRITE_IMPLEMENTATION
@@ -26,6 +28,7 @@
 #include <string_view>
 #include <vector>
 
+#include "import/texture_decode.h"
 #include "vox/core/error.h"
 #include "vox/import/import.h"
 #include "vox/io/input_file.h"
@@ -33,7 +36,10 @@
 namespace vox {
 namespace {
 
-bool skipImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+bool keepImageBytes(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
+                    const unsigned char* bytes, int size, void*) {
+  if (image->bufferView != -1 || size <= 0) return true;  // bufferView images: see GltfReader::imageBytes
+  image->image.assign(bytes, bytes + size);
   return true;
 }
 
@@ -112,10 +118,12 @@ class GltfReader {
     std::vector<bool> onPath(model_.nodes.size(), false);
     for (int root : roots) visitNode(root, Mat4::identity(), onPath, 0);
 
-    if (usesDefaultMaterial_ || scene_.materials.empty()) {
-      // Index defaultMaterial_ == model_.materials.size(), reserved in readMaterials.
+    if (usesDefaultMaterial_ || scene_.materials.empty() || !clones_.empty()) {
+      // Index defaultMaterial_ == model_.materials.size(), reserved in readMaterials; clones follow it.
       scene_.materials.push_back(Material{"default"});
     }
+    for (const Material& m : clones_) scene_.materials.push_back(m);
+    if (!scene_.triangleUVs.empty()) scene_.triangleUVs.resize(scene_.triangles.size());
     return std::move(scene_);
   }
 
@@ -134,17 +142,140 @@ class GltfReader {
   }
 
   void readMaterials() {
-    bool textured = false;
-    for (const auto& m : model_.materials) {
+    textureOf_.assign(model_.textures.size(), kUnread);
+    for (size_t i = 0; i < model_.materials.size(); ++i) {
+      const tinygltf::Material& m = model_.materials[i];
       Material out;
       out.name = m.name;
       const auto& f = m.pbrMetallicRoughness.baseColorFactor;
       if (f.size() >= 3) out.diffuse = {f[0], f[1], f[2]};
-      if (m.pbrMetallicRoughness.baseColorTexture.index >= 0) textured = true;
+      const tinygltf::TextureInfo& info = m.pbrMetallicRoughness.baseColorTexture;
+      if (info.index >= 0) {
+        out.diffuseTexture = readTexture(int(i), info.index);
+        if (info.extensions.count("KHR_texture_transform"))
+          warn("material ", i, ": KHR_texture_transform of the base colour texture is ignored");
+      }
+      texCoordSet_.push_back(info.texCoord);
       scene_.materials.push_back(out);
     }
     defaultMaterial_ = static_cast<uint32_t>(scene_.materials.size());
-    if (textured) warn("base colour textures are used as their baseColorFactor only");
+  }
+
+  static TextureWrap wrapMode(int glMode) {
+    switch (glMode) {
+      case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return TextureWrap::ClampToEdge;
+      case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return TextureWrap::MirroredRepeat;
+      case TINYGLTF_TEXTURE_WRAP_REPEAT: return TextureWrap::Repeat;
+      default: return TextureWrap(255);
+    }
+  }
+
+  // The scene texture of glTF texture `index` (decoded once, however many materials use it), or kNoTexture with
+  // a warning when its image is in a format outside core glTF (no `source`).
+  uint32_t readTexture(int material, int index) {
+    if (size_t(index) >= model_.textures.size())
+      failHere("material ", material, ": baseColorTexture ", index, " does not exist (", model_.textures.size(),
+               " textures)");
+    uint32_t& slot = textureOf_[size_t(index)];
+    if (slot != kUnread) return slot;
+    const tinygltf::Texture& t = model_.textures[size_t(index)];
+    slot = kNoTexture;
+    if (t.source < 0) {
+      warn("texture ", index, ": no PNG or JPEG source (an extension's image?); material ", material,
+           " uses its baseColorFactor");
+      return slot;
+    }
+    if (size_t(t.source) >= model_.images.size())
+      failHere("texture ", index, ": image ", t.source, " does not exist (", model_.images.size(), " images)");
+    const tinygltf::Image& image = model_.images[size_t(t.source)];
+    const std::string where = path_ + ": image " + std::to_string(t.source);
+    const std::string name = image.uri.rfind("data:", 0) == 0 ? "image " + std::to_string(t.source)
+                             : !image.uri.empty()              ? image.uri
+                                                               : (image.name.empty() ? "image " + std::to_string(t.source) : image.name);
+    Texture texture = decodeTexture(imageBytes(t.source), image.uri.rfind("data:", 0) == 0 ? "" : name, where);
+    texture.name = name;
+    if (t.sampler >= 0) {
+      if (size_t(t.sampler) >= model_.samplers.size())
+        failHere("texture ", index, ": sampler ", t.sampler, " does not exist (", model_.samplers.size(), " samplers)");
+      const tinygltf::Sampler& s = model_.samplers[size_t(t.sampler)];
+      texture.wrapU = wrapMode(s.wrapS);
+      texture.wrapV = wrapMode(s.wrapT);
+      if (texture.wrapU == TextureWrap(255) || texture.wrapV == TextureWrap(255))
+        failHere("sampler ", t.sampler, ": wrap mode ", s.wrapS, " / ", s.wrapT, " is not a glTF wrap mode");
+    }
+    slot = uint32_t(scene_.textures.size());
+    scene_.textures.push_back(std::move(texture));
+    return slot;
+  }
+
+  // The encoded bytes of image `index`: kept by keepImageBytes for uris, read from the bufferView here.
+  std::string imageBytes(int index) {
+    const tinygltf::Image& image = model_.images[size_t(index)];
+    if (image.bufferView == -1) {
+      if (image.image.empty()) failHere("image ", index, ": no image data (uri '", quoteInput(image.uri), "')");
+      return std::string(image.image.begin(), image.image.end());
+    }
+    if (image.bufferView < 0 || size_t(image.bufferView) >= model_.bufferViews.size())
+      failHere("image ", index, ": bufferView ", image.bufferView, " does not exist");
+    const tinygltf::BufferView& bv = model_.bufferViews[size_t(image.bufferView)];
+    if (bv.buffer < 0 || size_t(bv.buffer) >= model_.buffers.size())
+      failHere("image ", index, ": bufferView ", image.bufferView, ": buffer ", bv.buffer, " does not exist");
+    const std::vector<unsigned char>& data = model_.buffers[size_t(bv.buffer)].data;
+    if (bv.byteOffset > data.size() || bv.byteLength > data.size() - bv.byteOffset)
+      failHere("image ", index, ": bufferView ", image.bufferView, " (offset ", bv.byteOffset, ", length ",
+               bv.byteLength, ") exceeds buffer ", bv.buffer, " (", data.size(), " bytes)");
+    const auto* begin = reinterpret_cast<const char*>(data.data()) + bv.byteOffset;
+    return std::string(begin, bv.byteLength);
+  }
+
+  // A copy of textured `material` without its texture, for primitives that have no texture coordinates.
+  uint32_t untexturedClone(uint32_t material) {
+    for (size_t k = 0; k < clones_.size(); ++k)
+      if (cloneOf_[k] == material) return defaultMaterial_ + 1 + uint32_t(k);
+    Material m = scene_.materials[material];
+    m.diffuseTexture = kNoTexture;
+    clones_.push_back(m);
+    cloneOf_.push_back(material);
+    return defaultMaterial_ + uint32_t(clones_.size());
+  }
+
+  // TEXCOORD_n of a primitive as doubles (float exactly; normalized unsigned bytes and shorts as the glTF
+  // specification maps them), one per vertex.
+  std::vector<TexCoord> readTexCoords(int accessorIndex, size_t vertexCount) {
+    if (accessorIndex < 0 || static_cast<size_t>(accessorIndex) >= model_.accessors.size())
+      failHere("accessor ", accessorIndex, " does not exist (", model_.accessors.size(), " accessors)");
+    const tinygltf::Accessor& a = model_.accessors[static_cast<size_t>(accessorIndex)];
+    const int ct = a.componentType;
+    const bool isFloat = ct == TINYGLTF_COMPONENT_TYPE_FLOAT;
+    if (a.type != TINYGLTF_TYPE_VEC2 ||
+        !(isFloat || (a.normalized && (ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                                       ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT))))
+      failHere("accessor ", accessorIndex, ": TEXCOORD must be VEC2 of float or normalized unsigned byte or short");
+    const size_t size = componentSize(ct);
+    const View view = accessorView(accessorIndex, 2 * size);
+    if (view.count != vertexCount)
+      failHere("accessor ", accessorIndex, ": ", view.count, " texture coordinates for ", vertexCount, " vertices");
+    std::vector<TexCoord> out(view.count);
+    for (size_t i = 0; i < view.count; ++i) {
+      const unsigned char* p = view.base + i * view.stride;
+      double uv[2];
+      for (int k = 0; k < 2; ++k) {
+        if (isFloat) {
+          float f;
+          std::memcpy(&f, p + 4 * k, 4);
+          uv[k] = f;
+        } else if (size == 1) {
+          uv[k] = p[k] / 255.0;
+        } else {
+          uint16_t v16;
+          std::memcpy(&v16, p + 2 * k, 2);
+          uv[k] = v16 / 65535.0;
+        }
+        if (!std::isfinite(uv[k])) failHere("accessor ", accessorIndex, ": texture coordinate ", i, " is not finite");
+      }
+      out[i] = {uv[0], uv[1]};
+    }
+    return out;
   }
 
   // The recursion keeps only a matrix per level; everything with a large frame (error formatting, mesh reading)
@@ -377,9 +508,27 @@ class GltfReader {
         failHere("mesh ", meshIndex, " primitive ", p, ": material ", prim.material, " does not exist");
       else
         usesDefaultMaterial_ = true;
+      std::vector<TexCoord> uv;
+      if (material < model_.materials.size() && scene_.materials[material].diffuseTexture != kNoTexture) {
+        const int set = texCoordSet_[material];
+        const auto tc = prim.attributes.find("TEXCOORD_" + std::to_string(set));
+        if (tc != prim.attributes.end()) {
+          uv = readTexCoords(tc->second, vertices.size());
+        } else {
+          warn("mesh ", meshIndex, " primitive ", p, ": no TEXCOORD_", set, " for the base colour texture of material ",
+               material, "; its baseColorFactor is used");
+          material = untexturedClone(material);
+        }
+      }
 
       auto emit = [&](uint32_t a, uint32_t b, uint32_t c) {
         scene_.triangles.push_back({{vertices[a], vertices[b], vertices[c]}, material});
+        if (!uv.empty()) {
+          scene_.triangleUVs.resize(scene_.triangles.size() - 1);  // zeros for the untextured triangles before
+          scene_.triangleUVs.push_back({uv[a], uv[b], uv[c]});
+        } else if (!scene_.triangleUVs.empty()) {
+          scene_.triangleUVs.push_back({});
+        }
       };
       if (mode == TINYGLTF_MODE_TRIANGLES) {
         if (index.size() % 3 != 0)
@@ -404,6 +553,11 @@ class GltfReader {
   Scene scene_;
   uint32_t defaultMaterial_ = 0;
   bool usesDefaultMaterial_ = false;
+  static constexpr uint32_t kUnread = kNoTexture - 1;
+  std::vector<uint32_t> textureOf_;  // glTF texture -> scene texture, kNoTexture, or kUnread
+  std::vector<int> texCoordSet_;     // per glTF material: the TEXCOORD_n of its base colour texture
+  std::vector<Material> clones_;     // untextured copies, materials defaultMaterial_ + 1 + k
+  std::vector<uint32_t> cloneOf_;
   size_t visits_ = 0;
 };
 
@@ -528,7 +682,7 @@ class InstanceCounter {
   std::vector<double> memo_;
 };
 
-void checkInstancedTriangles(const std::string& path, const tinygltf::Model& model) {
+void checkInstancedTriangles(const std::string& path, const tinygltf::Model& model, bool textured) {
   InstanceCounter count(model);
   double total = 0;
   if (!model.scenes.empty()) {
@@ -538,8 +692,10 @@ void checkInstancedTriangles(const std::string& path, const tinygltf::Model& mod
   } else {
     for (int root : parentlessNodes(model)) total += count.node(root, 0);
   }
-  // A triangle costs its world-space copy (sizeof(Triangle)) and, in the grid, at least one reference.
-  checkMemory(total * double(sizeof(Triangle) + 8), path,
+  // A triangle costs its world-space copy (sizeof(Triangle)), its texture coordinates in a textured scene, and, in
+  // the grid, at least one reference.
+  const double uvBytes = textured ? double(sizeof(std::array<TexCoord, 3>)) : 0;
+  checkMemory(total * (double(sizeof(Triangle) + 8) + uvBytes), path,
               "instancing " + std::to_string(uint64_t(std::min(total, 1e19))) + " triangles");
 }
 
@@ -605,7 +761,7 @@ Scene importGltf(const std::string& path) {
   checkExternalUris(path, json);
   FolderGuard guard{path, {}};
   tinygltf::TinyGLTF loader;
-  loader.SetImageLoader(skipImage, nullptr);
+  loader.SetImageLoader(keepImageBytes, nullptr);
   loader.SetFsCallbacks({guardedFileExists, keepPath, guardedReadWholeFile, refuseWrite, &guard});
   tinygltf::Model model;
   std::string err, warn;
@@ -620,7 +776,10 @@ Scene importGltf(const std::string& path) {
     for (const std::string& line : nonEmptyLines(err)) message += (message.empty() ? "" : "; ") + line;
     fail<InputError>(path, ": ", message.empty() ? std::string("cannot read glTF file") : quoteInput(message, 300));
   }
-  checkInstancedTriangles(path, model);
+  const bool textured = std::any_of(model.materials.begin(), model.materials.end(), [](const tinygltf::Material& m) {
+    return m.pbrMetallicRoughness.baseColorTexture.index >= 0;
+  });
+  checkInstancedTriangles(path, model, textured);
 
   Scene scene = GltfReader(path, model).read();
   for (const std::string& line : nonEmptyLines(warn)) scene.warnings.push_back(path + ": " + quoteInput(line, 300));

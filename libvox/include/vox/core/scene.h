@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "vox/core/math.h"
+#include "vox/core/texture.h"
 
 namespace vox {
 
@@ -20,6 +21,9 @@ struct Material {
   Vec3 reflective{0, 0, 0};
   Vec3 transparent{0, 0, 0};
   double indexOfRefraction = 1;
+  // An image texture (Scene::textures index) whose colour `diffuse` multiplies (glTF baseColorTexture, OBJ
+  // map_Kd), over the triangles' Scene::triangleUVs; kNoTexture for none.
+  uint32_t diffuseTexture = kNoTexture;
 };
 
 struct Triangle {
@@ -72,6 +76,8 @@ struct Scene {
   std::vector<Triangle> triangles;
   std::vector<Sphere> spheres;
   std::vector<Plane> planes;
+  std::vector<Texture> textures;                     // referenced by Material::diffuseTexture
+  std::vector<std::array<TexCoord, 3>> triangleUVs;  // empty (no texture coordinates), or one per triangle
   std::optional<Camera> camera;      // none: tools frame the bounds (defaultCamera)
   std::vector<Light> lights;         // empty: tools add a headlight
   Vec3 background{0.5, 0.5, 0.5};

@@ -36,6 +36,11 @@ using Rgb8 = std::array<uint8_t, 3>;
 // Colour of solid cells (vox-voxelize --fill): they hold no primitive, so neither count nor material applies.
 inline constexpr Rgb8 kSolidCellColor{153, 153, 153};
 
+// The display colour of each occupied cell (grid.cellKeys order) under `color`, as buildVoxelMesh paints its faces
+// (for the voxel formats, which colour cells rather than faces); empty for ColorMode::None. Throws InputError like
+// buildVoxelMesh for an inconsistent cell table or a primitive or material out of range.
+std::vector<Rgb8> occupiedCellColors(const Grid& grid, const Scene& scene, ColorMode color);
+
 // A polygon mesh of plain arrays. Positions are world space (the grid's frame), on the grid lattice given by
 // cellBoundary. Face f has the vertices faceVertices[faceStart[f] .. faceStart[f+1]), counter-clockwise seen from
 // outside the voxels (so normals point out of the voxels). faceColors is empty (no colour) or holds one 8-bit

@@ -1,0 +1,146 @@
+// binvox writer (binvox_writer.h). The format's order (x slowest, then z, then y) is the transpose of our keys
+// (x fastest), so the cube is swept plane by plane along x: each voxel row of the grid (a run along x at fixed
+// j, k) turns bit k*D + j of the plane on where it starts and off where it ends, and each plane is run-length
+// encoded from its bit words. Planes are visited in x order, and the bits within a plane in z-then-y order, which is
+// exactly binvox's index x*D*D + z*D + y.
+// Format: https://www.patrickmin.com/binvox/binvox.html and binvox-rw-py (read_as_3d_array: values and counts
+// alternate; the flat array is reshaped to (D, D, D) and transposed (0, 2, 1) to x, y, z).
+#include "vox/export/binvox_writer.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "vox/core/error.h"
+#include "vox/export/voxel_runs.h"
+#include "vox/io/input_file.h"
+
+namespace vox {
+
+namespace {
+
+// Run-length encoder of a bit stream into binvox (value, count) pairs; runs longer than 255 are split.
+class RunEncoder {
+ public:
+  explicit RunEncoder(std::ostream& out) : out_(out) {}
+  void add(bool value, uint64_t n) {
+    if (n == 0) return;
+    if (value != value_) {
+      emit();
+      value_ = value;
+    }
+    count_ += n;
+  }
+  void finish() {
+    emit();
+    flushBuffer();
+  }
+
+ private:
+  void emit() {
+    while (count_ > 0) {
+      const uint64_t n = std::min<uint64_t>(count_, 255);
+      buffer_.push_back(char(value_ ? 1 : 0));
+      buffer_.push_back(char(uint8_t(n)));
+      count_ -= n;
+      if (buffer_.size() >= (1u << 20)) flushBuffer();
+    }
+  }
+  void flushBuffer() {
+    out_.write(buffer_.data(), std::streamsize(buffer_.size()));
+    buffer_.clear();
+  }
+  std::ostream& out_;
+  std::string buffer_;
+  bool value_ = false;
+  uint64_t count_ = 0;
+};
+
+// Encodes `bits` (the first `nbits` of them) in order.
+void encodePlane(const std::vector<uint64_t>& words, uint64_t nbits, RunEncoder& enc) {
+  for (size_t w = 0; w < words.size(); ++w) {
+    const unsigned valid = unsigned(std::min<uint64_t>(64, nbits - 64 * w));
+    uint64_t word = words[w];
+    if (word == 0 || (valid == 64 && word == ~uint64_t(0))) {
+      enc.add(word != 0, valid);
+      continue;
+    }
+    unsigned done = 0;
+    while (done < valid) {
+      const bool bit = word & 1;
+      unsigned n = bit ? unsigned(std::countr_one(word)) : unsigned(std::countr_zero(word));
+      n = std::min(n, valid - done);
+      enc.add(bit, n);
+      done += n;
+      word = n >= 64 ? 0 : word >> n;
+    }
+  }
+}
+
+}  // namespace
+
+BinvoxLayout binvoxLayout(const Grid& grid) {
+  BinvoxLayout layout;
+  const auto& n = grid.dims;
+  layout.dim = std::max({n[0], n[1], n[2]});
+  if (layout.dim > kBinvoxMaxDim)
+    fail<LimitError>("binvox: the grid's ", layout.dim, " cells on its longest axis exceed the ", kBinvoxMaxDim,
+                     " that binvox readers can expand densely");
+  int longest = 0;
+  for (int a = 1; a < 3; ++a)
+    if (n[a] > n[longest]) longest = a;
+  auto side = [&](int a) { return (grid.bounds.hi[a] - grid.bounds.lo[a]) / double(n[a]); };
+  layout.voxelSide = side(longest);
+  layout.translate = grid.bounds.lo;
+  layout.scale = layout.voxelSide * double(layout.dim);
+  for (int a = 0; a < 3; ++a)
+    layout.farFaceShiftVoxels =
+        std::max(layout.farFaceShiftVoxels, double(n[a]) * std::fabs(side(a) - layout.voxelSide) / layout.voxelSide);
+  return layout;
+}
+
+BinvoxLayout writeBinvox(std::ostream& out, const Grid& grid, const std::function<void(double)>& progress) {
+  const BinvoxLayout layout = binvoxLayout(grid);
+  const uint64_t d = layout.dim;
+  const uint64_t planeBits = d * d;
+  // Toggle events bucketed by the plane x where they happen (x = D: past the last plane, dropped).
+  uint64_t rows = 0;
+  forEachVoxelRow(grid, [&](const VoxelRow&) { ++rows; });
+  checkMemory(double(rows) * 2 * sizeof(uint32_t) + double(d + 1) * sizeof(uint64_t) + double(planeBits) / 8,
+              "binvox", "run events and one plane");
+  std::vector<uint64_t> eventStart(d + 2, 0);
+  forEachVoxelRow(grid, [&](const VoxelRow& r) {
+    ++eventStart[r.i0 + 1];
+    ++eventStart[r.i0 + r.count + 1];
+  });
+  for (size_t x = 1; x < eventStart.size(); ++x) eventStart[x] += eventStart[x - 1];
+  std::vector<uint32_t> events(eventStart.back());
+  {
+    std::vector<uint64_t> fill(eventStart.begin(), eventStart.end() - 1);
+    forEachVoxelRow(grid, [&](const VoxelRow& r) {
+      const uint32_t bit = uint32_t(uint64_t(r.k) * d + r.j);  // D <= 4096, so D*D < 2^32
+      events[fill[r.i0]++] = bit;
+      events[fill[r.i0 + r.count]++] = bit;
+    });
+  }
+
+  char header[256];
+  std::snprintf(header, sizeof header, "#binvox 1\ndim %u %u %u\ntranslate %.17g %.17g %.17g\nscale %.17g\ndata\n",
+                layout.dim, layout.dim, layout.dim, layout.translate.x, layout.translate.y, layout.translate.z,
+                layout.scale);
+  out << header;
+  RunEncoder enc(out);
+  std::vector<uint64_t> plane((planeBits + 63) / 64, 0);
+  for (uint64_t x = 0; x < d; ++x) {
+    for (uint64_t e = eventStart[x]; e < eventStart[x + 1]; ++e) plane[events[e] / 64] ^= uint64_t(1) << (events[e] % 64);
+    encodePlane(plane, planeBits, enc);
+    if (progress && x % 64 == 0) progress(double(x) / double(d));
+  }
+  enc.finish();
+  return layout;
+}
+
+}  // namespace vox

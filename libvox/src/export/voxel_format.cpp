@@ -1,0 +1,57 @@
+// Voxel file formats (voxel_format.h): extension dispatch over the three writers.
+#include "vox/export/voxel_format.h"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+
+#include "vox/export/binvox_writer.h"
+#include "vox/export/magicavoxel_writer.h"
+#include "vox/export/vdb_writer.h"
+#include "vox/export/voxel_runs.h"
+#include "vox/io/atomic_file.h"
+
+namespace vox {
+
+std::optional<VoxelFormat> voxelFormatFromPath(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  if (ext == ".binvox") return VoxelFormat::Binvox;
+  if (ext == ".vox") return VoxelFormat::MagicaVoxel;
+  if (ext == ".vdb") return VoxelFormat::Vdb;
+  return std::nullopt;
+}
+
+VoxelFileReport writeVoxelFile(const std::string& path, VoxelFormat format, const Grid& grid,
+                               std::span<const Rgb8> cellColors, const std::function<void(double)>& progress) {
+  VoxelFileReport report;
+  OutputFile file(path);
+  switch (format) {
+    case VoxelFormat::Binvox: {
+      const BinvoxLayout layout = writeBinvox(file.stream(), grid, progress);
+      report.voxels = countVoxels(grid);
+      report.binvoxShiftVoxels = layout.farFaceShiftVoxels;
+      report.binvoxVoxelSide = layout.voxelSide;
+      break;
+    }
+    case VoxelFormat::MagicaVoxel: {
+      const MagicaVoxelStats s = writeMagicaVoxel(file.stream(), grid, cellColors, kSolidCellColor, progress);
+      report.voxels = s.voxels;
+      report.models = s.models;
+      report.gridColors = s.gridColors;
+      report.paletteColors = s.paletteColors;
+      report.paletteReduced = s.paletteReduced;
+      break;
+    }
+    case VoxelFormat::Vdb: {
+      const VdbStats s = writeVdb(file.stream(), grid, progress);
+      report.voxels = s.activeVoxels;
+      report.models = s.leafNodes;
+      break;
+    }
+  }
+  file.commit();
+  return report;
+}
+
+}  // namespace vox

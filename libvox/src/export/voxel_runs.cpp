@@ -1,0 +1,69 @@
+// Voxel runs (voxel_runs.h): a merge of the sorted occupied keys with the sorted solid runs.
+#include "vox/export/voxel_runs.h"
+
+#include <algorithm>
+
+#include "vox/core/error.h"
+
+namespace vox {
+
+namespace {
+
+// Cuts the key range [first, end) at row ends and reports each piece.
+void emitRows(const Grid& grid, uint64_t first, uint64_t end, const std::function<void(const VoxelRow&)>& visit) {
+  const uint64_t nx = grid.dims[0];
+  while (first < end) {
+    const uint64_t row = first / nx;
+    const uint64_t rowEnd = std::min(end, (row + 1) * nx);
+    VoxelRow r;
+    r.key = first;
+    r.i0 = uint32_t(first - row * nx);
+    r.j = uint32_t(row % grid.dims[1]);
+    r.k = uint32_t(row / grid.dims[1]);
+    r.count = uint32_t(rowEnd - first);
+    visit(r);
+    first = rowEnd;
+  }
+}
+
+}  // namespace
+
+void forEachVoxelRow(const Grid& grid, const std::function<void(const VoxelRow&)>& visit) {
+  const uint64_t cells = grid.cellCount();
+  checkSolidRuns(grid.solidRuns, cells, "grid");
+  const std::vector<uint64_t>& keys = grid.cellKeys;
+  size_t a = 0, b = 0;
+  bool open = false;
+  uint64_t first = 0, end = 0;  // the run being grown, [first, end)
+  while (a < keys.size() || b < grid.solidRuns.size()) {
+    uint64_t start, stop;
+    if (b == grid.solidRuns.size() || (a < keys.size() && keys[a] < grid.solidRuns[b].first)) {
+      start = keys[a];
+      if (start >= cells) fail<InputError>("grid: cell key ", start, " outside the grid");
+      if (a > 0 && start <= keys[a - 1]) fail<InputError>("grid: cell keys not sorted at index ", a);
+      stop = start + 1;
+      ++a;
+    } else {
+      start = grid.solidRuns[b].first;
+      stop = start + grid.solidRuns[b].count;
+      ++b;
+    }
+    if (open && start <= end) {
+      end = std::max(end, stop);
+      continue;
+    }
+    if (open) emitRows(grid, first, end, visit);
+    first = start;
+    end = stop;
+    open = true;
+  }
+  if (open) emitRows(grid, first, end, visit);
+}
+
+uint64_t countVoxels(const Grid& grid) {
+  uint64_t n = 0;
+  forEachVoxelRow(grid, [&](const VoxelRow& r) { n += r.count; });
+  return n;
+}
+
+}  // namespace vox

@@ -1,0 +1,445 @@
+// Tests of the voxel file writers (binvox_writer, magicavoxel_writer, vdb_writer, voxel_runs, voxel_format). Each
+// file is read back by a reader written here from the published descriptions (binvox: Patrick Min's page and
+// binvox-rw-py; .vox: ephtracy/voxel-model's two format texts), or, for .vdb, by OpenVDB itself; the voxel sets read
+// back must equal the grid's occupied and solid cells, cell for cell.
+#include <gtest/gtest.h>
+
+#include <openvdb/io/Stream.h>
+#include <openvdb/openvdb.h>
+
+#include <algorithm>
+#include <cstring>
+#include <map>
+#include <random>
+#include <set>
+#include <sstream>
+
+#include "test_util.h"
+#include "vox/core/error.h"
+#include "vox/export/binvox_writer.h"
+#include "vox/export/magicavoxel_writer.h"
+#include "vox/export/vdb_writer.h"
+#include "vox/export/voxel_format.h"
+#include "vox/export/voxel_runs.h"
+
+namespace vox {
+namespace {
+
+using Cell = std::array<uint32_t, 3>;
+
+// A random grid: occupied cells (each with 1..3 primitives) and solid runs, some overlapping occupied cells and
+// crossing rows, over non-cubic cells.
+Grid randomGrid(const std::array<uint32_t, 3>& dims, uint32_t seed, int occupied, int runs) {
+  std::mt19937_64 rng(seed);
+  Grid g;
+  g.dims = dims;
+  g.bounds = {{-1.5, 2, 0.25}, {-1.5 + 0.5 * dims[0], 2 + 0.25 * dims[1], 0.25 + 0.75 * dims[2]}};
+  const uint64_t cells = g.cellCount();
+  std::set<uint64_t> keys;
+  for (int i = 0; i < occupied; ++i) keys.insert(rng() % cells);
+  g.cellKeys.assign(keys.begin(), keys.end());
+  for (size_t c = 0; c < g.cellKeys.size(); ++c) {
+    for (uint32_t p = 0; p <= c % 3; ++p) g.primIds.push_back(p);
+    g.cellStart.push_back(g.primIds.size());
+  }
+  std::set<uint64_t> starts;
+  for (int r = 0; r < runs; ++r) starts.insert(rng() % cells);
+  uint64_t end = 0;
+  for (uint64_t s : starts) {
+    if (s <= end && !g.solidRuns.empty()) continue;
+    const uint64_t n = std::min<uint64_t>(1 + rng() % (3 * dims[0]), cells - s);
+    g.solidRuns.push_back({s, n});
+    end = s + n;
+  }
+  return g;
+}
+
+// The voxels, by brute force over keys.
+std::set<Cell> voxelSet(const Grid& g) {
+  std::set<Cell> out;
+  for (uint64_t k : g.cellKeys) out.insert(cellIndex(g.dims, k));
+  for (const CellRun& r : g.solidRuns)
+    for (uint64_t k = r.first; k < r.first + r.count; ++k) out.insert(cellIndex(g.dims, k));
+  return out;
+}
+
+TEST(VoxelRuns, UnionOfOccupiedAndSolidCellsInKeyOrderCutAtRows) {
+  const Grid g = randomGrid({37, 11, 9}, 1, 400, 30);
+  std::set<Cell> seen;
+  uint64_t lastEnd = 0;
+  bool first = true;
+  forEachVoxelRow(g, [&](const VoxelRow& r) {
+    ASSERT_GE(r.count, 1u);
+    ASSERT_LE(r.i0 + r.count, g.dims[0]);
+    ASSERT_EQ(r.key, cellKey(g.dims, r.i0, r.j, r.k));
+    // Maximal: a run that does not start a row never touches the previous one.
+    if (!first && r.i0 > 0) {
+      ASSERT_GT(r.key, lastEnd);
+    }
+    if (!first) {
+      ASSERT_GE(r.key, lastEnd);
+    }
+    first = false;
+    lastEnd = r.key + r.count;
+    for (uint32_t c = 0; c < r.count; ++c) ASSERT_TRUE(seen.insert({r.i0 + c, r.j, r.k}).second);
+  });
+  EXPECT_EQ(seen, voxelSet(g));
+  EXPECT_EQ(countVoxels(g), seen.size());
+}
+
+TEST(VoxelRuns, RefusesUnsortedKeysAndBadRuns) {
+  Grid g = randomGrid({8, 8, 8}, 2, 20, 3);
+  Grid bad = g;
+  std::swap(bad.cellKeys[0], bad.cellKeys[1]);
+  EXPECT_THROW(countVoxels(bad), InputError);
+  bad = g;
+  bad.cellKeys.back() = g.cellCount();
+  EXPECT_THROW(countVoxels(bad), InputError);
+  bad = g;
+  bad.solidRuns.push_back({g.cellCount() - 1, 5});
+  EXPECT_THROW(countVoxels(bad), InputError);
+}
+
+// ---- binvox, read as binvox-rw-py does: header lines, then (value, count) pairs over x*D*D + z*D + y.
+struct Binvox {
+  uint32_t dims[3] = {0, 0, 0};
+  double translate[3] = {0, 0, 0};
+  double scale = 0;
+  std::set<Cell> voxels;  // (x, y, z)
+  uint64_t decoded = 0;   // cells covered by the runs
+};
+
+Binvox readBinvox(const std::string& bytes) {
+  Binvox b;
+  std::istringstream in(bytes);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "#binvox 1");
+  while (std::getline(in, line) && line != "data") {
+    std::istringstream l(line);
+    std::string key;
+    l >> key;
+    if (key == "dim") l >> b.dims[0] >> b.dims[1] >> b.dims[2];
+    if (key == "translate") l >> b.translate[0] >> b.translate[1] >> b.translate[2];
+    if (key == "scale") l >> b.scale;
+  }
+  EXPECT_EQ(line, "data");
+  const uint64_t d = b.dims[0];
+  char pair[2];
+  while (in.read(pair, 2)) {
+    const uint8_t value = uint8_t(pair[0]), count = uint8_t(pair[1]);
+    EXPECT_TRUE(value == 0 || value == 1);
+    EXPECT_GE(count, 1);
+    for (uint32_t c = 0; c < count; ++c, ++b.decoded) {
+      if (!value) continue;
+      const uint64_t x = b.decoded / (d * d), z = (b.decoded / d) % d, y = b.decoded % d;
+      b.voxels.insert({uint32_t(x), uint32_t(y), uint32_t(z)});
+    }
+  }
+  EXPECT_EQ(in.gcount(), 0) << "odd byte at the end";
+  return b;
+}
+
+TEST(Binvox, ReadBackEqualsTheGridsVoxels) {
+  for (const auto& dims : {std::array<uint32_t, 3>{37, 11, 9}, {5, 70, 23}, {1, 1, 1}, {130, 3, 129}}) {
+    const Grid g = randomGrid(dims, dims[0] * 7 + dims[1], 300, 25);
+    std::ostringstream out;
+    const BinvoxLayout layout = writeBinvox(out, g);
+    const Binvox b = readBinvox(out.str());
+    const uint32_t d = std::max({dims[0], dims[1], dims[2]});
+    EXPECT_EQ(b.dims[0], d);
+    EXPECT_EQ(b.dims[1], d);
+    EXPECT_EQ(b.dims[2], d);
+    EXPECT_EQ(b.decoded, uint64_t(d) * d * d);
+    EXPECT_EQ(b.voxels, voxelSet(g));
+    for (int a = 0; a < 3; ++a) EXPECT_EQ(b.translate[a], g.bounds.lo[a]);
+    EXPECT_EQ(b.scale, layout.scale);
+    EXPECT_DOUBLE_EQ(layout.scale, layout.voxelSide * d);
+  }
+}
+
+TEST(Binvox, CubicCellsMapExactlyAndNonCubicOnesReportTheShift) {
+  Grid g = randomGrid({20, 10, 5}, 3, 50, 2);
+  g.bounds = {{0, 0, 0}, {2, 1, 0.5}};  // cells of 0.1 on every axis
+  BinvoxLayout l = binvoxLayout(g);
+  EXPECT_DOUBLE_EQ(l.voxelSide, 0.1);
+  EXPECT_NEAR(l.farFaceShiftVoxels, 0, 1e-9);
+  g.bounds = {{0, 0, 0}, {2, 1.1, 0.5}};  // y cells of 0.11: the far y face moves by 10 * 0.01 / 0.1 = 1 voxel
+  l = binvoxLayout(g);
+  EXPECT_NEAR(l.farFaceShiftVoxels, 1.0, 1e-9);
+  g.dims = {kBinvoxMaxDim + 1, 1, 1};
+  g.cellKeys.clear(), g.cellStart = {0}, g.primIds.clear(), g.solidRuns.clear();
+  EXPECT_THROW(binvoxLayout(g), LimitError);
+}
+
+// ---- MagicaVoxel, read from the format texts: RIFF chunks, SIZE/XYZI models, nTRN/nGRP/nSHP, RGBA.
+struct VoxFile {
+  struct Model {
+    uint32_t size[3];
+    std::vector<std::array<uint8_t, 4>> voxels;
+  };
+  std::vector<Model> models;
+  std::map<uint32_t, std::array<int64_t, 3>> modelTranslation;  // model id -> "_t" of its transform
+  std::array<std::array<uint8_t, 4>, 256> palette{};           // palette[i] is colour index i + 1
+};
+
+struct ByteReader {
+  const std::string& s;
+  size_t at = 0;
+  uint32_t u32() {
+    EXPECT_LE(at + 4, s.size());
+    uint32_t v = 0;
+    for (int b = 0; b < 4; ++b) v |= uint32_t(uint8_t(s[at + b])) << (8 * b);
+    at += 4;
+    return v;
+  }
+  std::string str() {
+    const uint32_t n = u32();
+    std::string v = s.substr(at, n);
+    at += n;
+    return v;
+  }
+  std::map<std::string, std::string> dict() {
+    std::map<std::string, std::string> d;
+    for (uint32_t n = u32(); n > 0; --n) {
+      std::string k = str();
+      d[k] = str();
+    }
+    return d;
+  }
+};
+
+VoxFile readVox(const std::string& bytes) {
+  VoxFile f;
+  ByteReader r{bytes};
+  EXPECT_EQ(bytes.substr(0, 4), "VOX ");
+  r.at = 4;
+  EXPECT_EQ(r.u32(), 150u);
+  EXPECT_EQ(bytes.substr(8, 4), "MAIN");
+  r.at = 12;
+  EXPECT_EQ(r.u32(), 0u);
+  const uint32_t children = r.u32();
+  EXPECT_EQ(uint64_t(children) + 20, bytes.size());
+  std::map<uint32_t, std::pair<uint32_t, std::array<int64_t, 3>>> transforms;  // node -> child, translation
+  std::map<uint32_t, uint32_t> shapes;                                          // node -> model
+  while (r.at + 12 <= bytes.size()) {
+    const std::string id = bytes.substr(r.at, 4);
+    r.at += 4;
+    const uint32_t content = r.u32();
+    EXPECT_EQ(r.u32(), 0u);
+    const size_t next = r.at + content;
+    if (id == "SIZE") {
+      VoxFile::Model m;
+      for (auto& s : m.size) s = r.u32();
+      f.models.push_back(m);
+    } else if (id == "XYZI") {
+      const uint32_t n = r.u32();
+      EXPECT_EQ(content, 4 + 4 * n);
+      for (uint32_t v = 0; v < n; ++v) {
+        std::array<uint8_t, 4> x;
+        std::memcpy(x.data(), bytes.data() + r.at, 4);
+        r.at += 4;
+        f.models.back().voxels.push_back(x);
+      }
+    } else if (id == "nTRN") {
+      const uint32_t node = r.u32();
+      r.dict();
+      const uint32_t child = r.u32();
+      EXPECT_EQ(r.u32(), uint32_t(-1));
+      r.u32();  // layer
+      EXPECT_EQ(r.u32(), 1u);
+      auto frame = r.dict();
+      std::array<int64_t, 3> t{0, 0, 0};
+      if (frame.count("_t")) {
+        std::istringstream ts(frame["_t"]);
+        ts >> t[0] >> t[1] >> t[2];
+      }
+      transforms[node] = {child, t};
+    } else if (id == "nGRP") {
+      r.u32();
+      r.dict();
+      for (uint32_t n = r.u32(); n > 0; --n) r.u32();
+    } else if (id == "nSHP") {
+      const uint32_t node = r.u32();
+      r.dict();
+      EXPECT_EQ(r.u32(), 1u);
+      shapes[node] = r.u32();
+      r.dict();
+    } else if (id == "RGBA") {
+      for (auto& c : f.palette)
+        for (auto& ch : c) ch = uint8_t(bytes[r.at++]);
+    }
+    EXPECT_EQ(r.at, next) << id;
+    r.at = next;
+  }
+  EXPECT_EQ(r.at, bytes.size());
+  for (const auto& [node, ct] : transforms)
+    if (shapes.count(ct.first)) f.modelTranslation[shapes[ct.first]] = ct.second;
+  return f;
+}
+
+// World voxel positions of a .vox file: the model's voxel v sits at translation + v - floor(size / 2).
+std::map<Cell, Rgb8> voxWorld(const VoxFile& f) {
+  std::map<Cell, Rgb8> out;
+  for (uint32_t m = 0; m < f.models.size(); ++m) {
+    const auto& model = f.models[m];
+    EXPECT_TRUE(f.modelTranslation.count(m)) << "model " << m << " placed by no transform";
+    const auto t = f.modelTranslation.at(m);
+    for (int a = 0; a < 3; ++a) EXPECT_LE(model.size[a], 256u);
+    for (const auto& v : model.voxels) {
+      Cell c;
+      for (int a = 0; a < 3; ++a) {
+        EXPECT_LT(v[a], model.size[a]);
+        c[a] = uint32_t(t[a] + v[a] - model.size[a] / 2);
+      }
+      EXPECT_GE(v[3], 1);
+      const auto& p = f.palette[v[3] - 1];
+      EXPECT_TRUE(out.insert({c, Rgb8{p[0], p[1], p[2]}}).second);
+    }
+  }
+  return out;
+}
+
+TEST(MagicaVoxel, ReadBackEqualsTheGridsVoxelsAndColoursAcrossModels) {
+  // 300 x 5 x 520: 2 x 1 x 3 tiles, some empty.
+  const Grid g = randomGrid({300, 5, 520}, 4, 3000, 60);
+  std::vector<Rgb8> colors;
+  for (size_t c = 0; c < g.cellKeys.size(); ++c) colors.push_back({uint8_t(c % 7 * 30), uint8_t(c % 5), 200});
+  std::ostringstream out;
+  const MagicaVoxelStats s = writeMagicaVoxel(out, g, colors, kSolidCellColor);
+  const VoxFile f = readVox(out.str());
+  const auto world = voxWorld(f);
+  std::set<Cell> cells;
+  for (const auto& [c, col] : world) cells.insert(c);
+  EXPECT_EQ(cells, voxelSet(g));
+  EXPECT_EQ(s.voxels, cells.size());
+  EXPECT_EQ(s.models, f.models.size());
+  EXPECT_GE(f.models.size(), 4u);
+  EXPECT_FALSE(s.paletteReduced);
+  for (size_t c = 0; c < g.cellKeys.size(); ++c) EXPECT_EQ(world.at(cellIndex(g.dims, g.cellKeys[c])), colors[c]);
+  for (const Cell& c : cells)
+    if (findCell(g, cellKey(g.dims, c[0], c[1], c[2])) < 0) {
+      EXPECT_EQ(world.at(c), kSolidCellColor);
+    }
+}
+
+TEST(MagicaVoxel, NoColoursAndEmptyGrid) {
+  const Grid g = randomGrid({20, 20, 20}, 5, 100, 5);
+  std::ostringstream out;
+  writeMagicaVoxel(out, g, {}, kSolidCellColor);
+  const auto world = voxWorld(readVox(out.str()));
+  EXPECT_EQ(world.size(), voxelSet(g).size());
+  for (const auto& [c, col] : world) EXPECT_EQ(col, kSolidCellColor);
+  Grid empty;
+  empty.dims = {4, 4, 4};
+  empty.bounds = {{0, 0, 0}, {1, 1, 1}};
+  std::ostringstream e;
+  EXPECT_EQ(writeMagicaVoxel(e, empty, {}, kSolidCellColor).models, 0u);
+  EXPECT_TRUE(readVox(e.str()).models.empty());
+  EXPECT_THROW(writeMagicaVoxel(e, g, std::vector<Rgb8>(3), kSolidCellColor), InputError);
+}
+
+TEST(MagicaVoxel, MoreThan255ColoursGetTheNearestOf255) {
+  const Grid g = randomGrid({64, 64, 64}, 6, 5000, 0);
+  std::vector<Rgb8> colors;
+  std::mt19937 rng(7);
+  for (size_t c = 0; c < g.cellKeys.size(); ++c) colors.push_back({uint8_t(rng()), uint8_t(rng()), uint8_t(rng())});
+  std::ostringstream out;
+  const MagicaVoxelStats s = writeMagicaVoxel(out, g, colors, kSolidCellColor);
+  EXPECT_TRUE(s.paletteReduced);
+  EXPECT_EQ(s.paletteColors, 255u);
+  const VoxFile f = readVox(out.str());
+  const auto world = voxWorld(f);
+  auto dist = [](const Rgb8& a, const std::array<uint8_t, 4>& b) {
+    int d = 0;
+    for (int ch = 0; ch < 3; ++ch) d += (int(a[ch]) - b[ch]) * (int(a[ch]) - b[ch]);
+    return d;
+  };
+  for (size_t c = 0; c < g.cellKeys.size(); ++c) {
+    const Rgb8 got = world.at(cellIndex(g.dims, g.cellKeys[c]));
+    int best = INT32_MAX;
+    for (int p = 0; p < 255; ++p) best = std::min(best, dist(colors[c], f.palette[p]));
+    EXPECT_EQ(dist(colors[c], {got[0], got[1], got[2], 255}), best);
+  }
+}
+
+TEST(MagicaVoxel, RefusesFilesBeyondTheInt32ChunkSizes) {
+  Grid g;
+  g.dims = {2048, 2048, 2048};
+  g.bounds = {{0, 0, 0}, {1, 1, 1}};
+  g.solidRuns.push_back({0, uint64_t(600) << 20});  // 629 M voxels: 2.5 GB of XYZI
+  std::ostringstream out;
+  EXPECT_THROW(writeMagicaVoxel(out, g, {}, kSolidCellColor), LimitError);
+  EXPECT_TRUE(out.str().empty());
+}
+
+TEST(Palette, AtMost255DistinctColoursAreKeptExactly) {
+  std::vector<Rgb8> c{{3, 2, 1}, {0, 0, 0}, {255, 255, 255}};
+  std::vector<uint64_t> w{1, 5, 2};
+  EXPECT_EQ(choosePalette(c, w), (std::vector<Rgb8>{{0, 0, 0}, {3, 2, 1}, {255, 255, 255}}));
+}
+
+// ---- OpenVDB, read back by OpenVDB.
+TEST(Vdb, DensityAndCountReadBackByOpenVdbInWorldSpace) {
+  const Grid g = randomGrid({40, 17, 30}, 8, 700, 40);
+  std::ostringstream out;
+  const VdbStats s = writeVdb(out, g);
+  const std::set<Cell> cells = voxelSet(g);
+  EXPECT_EQ(s.activeVoxels, cells.size());
+  std::istringstream in(out.str());
+  openvdb::initialize();
+  openvdb::io::Stream stream(in);
+  openvdb::GridPtrVecPtr grids = stream.getGrids();
+  ASSERT_EQ(grids->size(), 2u);
+  auto density = openvdb::gridPtrCast<openvdb::FloatGrid>(openvdb::findGridByName(*grids, "density"));
+  auto count = openvdb::gridPtrCast<openvdb::Int32Grid>(openvdb::findGridByName(*grids, "count"));
+  ASSERT_TRUE(density && count);
+  EXPECT_EQ(density->activeVoxelCount(), cells.size());
+  EXPECT_EQ(count->activeVoxelCount(), g.cellKeys.size());
+  auto acc = density->getConstAccessor();
+  for (const Cell& c : cells) {
+    const openvdb::Coord ijk{int(c[0]), int(c[1]), int(c[2])};
+    ASSERT_TRUE(acc.isValueOn(ijk));
+    ASSERT_EQ(acc.getValue(ijk), 1.0f);
+  }
+  for (size_t c = 0; c < g.cellKeys.size(); ++c) {
+    const Cell ijk = cellIndex(g.dims, g.cellKeys[c]);
+    EXPECT_EQ(count->tree().getValue(openvdb::Coord(int(ijk[0]), int(ijk[1]), int(ijk[2]))),
+              int(g.cellStart[c + 1] - g.cellStart[c]));
+  }
+  // Index (i, j, k) is the centre of cell (i, j, k); the cell's corners are the grid's boundaries.
+  const openvdb::Vec3d centre = density->transform().indexToWorld(openvdb::Vec3d(3, 5, 7));
+  const Box cell = cellBox(g, 3, 5, 7);
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(centre[a], 0.5 * (cell.lo[a] + cell.hi[a]), 1e-12);
+  const openvdb::Vec3d corner = density->transform().indexToWorld(openvdb::Vec3d(-0.5, -0.5, -0.5));
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(corner[a], g.bounds.lo[a], 1e-12);
+}
+
+TEST(Vdb, LongSolidRunsBecomeTiles) {
+  Grid g;
+  g.dims = {256, 256, 256};
+  g.bounds = {{0, 0, 0}, {1, 1, 1}};
+  for (uint32_t k = 0; k < 256; ++k)  // a full 256^3 block but for one corner cell per layer
+    g.solidRuns.push_back({cellKey(g.dims, 1, 0, k), 256 * 256 - 1});
+  std::ostringstream out;
+  const VdbStats s = writeVdb(out, g);
+  EXPECT_EQ(s.activeVoxels, g.solidCount());
+  EXPECT_EQ(s.leafNodes, 32u);  // only the 32 leaves holding the missing column (0, 0, k) stay leaves
+}
+
+TEST(VoxelFormat, ExtensionsAndFilesThroughTheOutputFile) {
+  EXPECT_EQ(voxelFormatFromPath("a/b.BINVOX"), VoxelFormat::Binvox);
+  EXPECT_EQ(voxelFormatFromPath("b.vox"), VoxelFormat::MagicaVoxel);
+  EXPECT_EQ(voxelFormatFromPath("b.Vdb"), VoxelFormat::Vdb);
+  EXPECT_FALSE(voxelFormatFromPath("b.ply").has_value());
+  testing::ScratchDir dir("voxel_formats");
+  const Grid g = randomGrid({10, 12, 14}, 9, 100, 4);
+  for (auto f : {VoxelFormat::Binvox, VoxelFormat::MagicaVoxel, VoxelFormat::Vdb}) {
+    const VoxelFileReport r = writeVoxelFile(dir.file("out"), f, g, {});
+    EXPECT_EQ(r.voxels, voxelSet(g).size());
+  }
+  EXPECT_THROW(writeVoxelFile(dir.file("missing/out.vox"), VoxelFormat::MagicaVoxel, g, {}), OutputError);
+}
+
+}  // namespace
+}  // namespace vox

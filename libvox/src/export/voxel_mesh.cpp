@@ -32,6 +32,7 @@
 #include <numeric>
 #include <unordered_map>
 
+#include "vox/export/cell_color.h"
 #include "vox/export/colormap.h"
 #include "vox/core/error.h"
 
@@ -84,33 +85,8 @@ struct Voxels {
   std::vector<uint32_t> colors;  // packed, kNoColor without colour
 };
 
-uint32_t materialOf(const Scene& scene, uint32_t prim) {
-  const size_t t = scene.triangles.size(), s = scene.spheres.size(), p = scene.planes.size();
-  if (prim < t) return scene.triangles[prim].material;
-  if (prim < t + s) return scene.spheres[prim - t].material;
-  if (prim < t + s + p) return scene.planes[prim - t - s].material;
-  fail<InputError>("grid: primitive id ", prim, " out of range (", t + s + p, " primitives)");
-}
-
 uint32_t majorityMaterialColor(const Grid& grid, const Scene& scene, size_t cell) {
-  // Cells hold few primitives: a small linear tally beats a map.
-  std::vector<std::pair<uint32_t, uint32_t>> tally;
-  for (uint32_t prim : grid.cellPrims(cell)) {
-    const uint32_t m = materialOf(scene, prim);
-    auto it = std::find_if(tally.begin(), tally.end(), [&](const auto& e) { return e.first == m; });
-    if (it == tally.end())
-      tally.push_back({m, 1});
-    else
-      ++it->second;
-  }
-  if (tally.empty()) return packColor(kSolidCellColor);
-  std::pair<uint32_t, uint32_t> best = tally[0];
-  for (const auto& e : tally)
-    if (e.second > best.second || (e.second == best.second && e.first < best.first)) best = e;
-  if (scene.materials.empty()) return packColor({255, 255, 255});
-  if (best.first >= scene.materials.size())
-    fail<InputError>("grid: material index ", best.first, " out of range (", scene.materials.size(), " materials)");
-  return packColor(toRgb8(scene.materials[best.first].diffuse));
+  return packColor(toRgb8(cellMaterialColor(grid, scene, cell)));  // image textures included (cell_color.h)
 }
 
 // The packed colour of each occupied cell (kNoColor for ColorMode::None); shared by the meshes and by

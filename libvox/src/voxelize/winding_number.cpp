@@ -1,0 +1,139 @@
+#include "vox/voxelize/winding_number.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <numeric>
+
+namespace vox {
+
+namespace {
+
+constexpr double kInv4Pi = 1.0 / (4.0 * std::numbers::pi);
+constexpr uint32_t kLeafSize = 8;
+
+struct BuildInput {
+  std::vector<std::array<Vec3, 3>> corners;
+  std::vector<Vec3> centroid;
+  std::vector<Vec3> areaNormal;  // (b - a) x (c - a) / 2: area times unit normal
+};
+
+// Fills the expansion of node `n` over triangles [first, first + count) of `in` (already in tree order).
+void summarize(WindingTree::Node& n, const BuildInput& in) {
+  double area = 0;
+  Vec3 weighted{0, 0, 0}, lo = in.corners[n.first][0], hi = lo;
+  for (uint32_t t = n.first; t < n.first + n.count; ++t) {
+    const double a = length(in.areaNormal[t]);
+    area += a;
+    weighted = weighted + in.centroid[t] * a;
+    n.normalSum = n.normalSum + in.areaNormal[t];
+    for (const Vec3& v : in.corners[t]) lo = minVec(lo, v), hi = maxVec(hi, v);
+  }
+  // Degenerate triangles have no area: fall back to the box centre, any point works for a zero expansion.
+  n.center = area > 0 ? weighted / area : (lo + hi) * 0.5;
+  for (uint32_t t = n.first; t < n.first + n.count; ++t) {
+    const Vec3 d = in.centroid[t] - n.center;
+    const Vec3& an = in.areaNormal[t];
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) n.moment[r * 3 + c] += an[r] * d[c];
+    for (const Vec3& v : in.corners[t]) n.radius = std::max(n.radius, length(v - n.center));
+  }
+}
+
+// Median split on the longest axis of the centroids, depth first, so that a subtree is a contiguous node range.
+void buildNode(WindingTree& tree, BuildInput& in, std::vector<uint32_t>& order, uint32_t first, uint32_t count) {
+  const uint32_t index = uint32_t(tree.nodes.size());
+  tree.nodes.emplace_back();
+  if (count > kLeafSize) {
+    Vec3 lo = in.centroid[order[first]], hi = lo;
+    for (uint32_t t = first; t < first + count; ++t) lo = minVec(lo, in.centroid[order[t]]), hi = maxVec(hi, in.centroid[order[t]]);
+    const Vec3 ext = hi - lo;
+    const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+    const uint32_t half = count / 2;
+    std::nth_element(order.begin() + first, order.begin() + first + half, order.begin() + first + count,
+                     [&](uint32_t a, uint32_t b) { return in.centroid[a][axis] < in.centroid[b][axis]; });
+    buildNode(tree, in, order, first, half);
+    buildNode(tree, in, order, first + half, count - half);
+  }
+  WindingTree::Node& n = tree.nodes[index];
+  n.first = first;
+  n.count = count;
+  n.skip = uint32_t(tree.nodes.size());
+}
+
+}  // namespace
+
+double triangleWindingNumber(const Vec3& a0, const Vec3& b0, const Vec3& c0, const Vec3& q) {
+  const Vec3 a = a0 - q, b = b0 - q, c = c0 - q;
+  const double la = length(a), lb = length(b), lc = length(c);
+  const double num = dot(a, cross(b, c));
+  if (num == 0) return 0;  // q in the triangle's plane (off the triangle: an empty cell's centre) or degenerate
+  const double den = la * lb * lc + dot(a, b) * lc + dot(a, c) * lb + dot(b, c) * la;
+  return 2 * std::atan2(num, den) * kInv4Pi;
+}
+
+double windingNumberExact(std::span<const Triangle> triangles, const Vec3& q) {
+  double w = 0;
+  for (const Triangle& t : triangles) w += triangleWindingNumber(t.v[0], t.v[1], t.v[2], q);
+  return w;
+}
+
+WindingTree buildWindingTree(std::span<const Triangle> triangles) {
+  WindingTree tree;
+  if (triangles.empty()) return tree;
+  const uint32_t n = uint32_t(triangles.size());
+  BuildInput in;
+  in.centroid.resize(n);
+  for (uint32_t t = 0; t < n; ++t) in.centroid[t] = (triangles[t].v[0] + triangles[t].v[1] + triangles[t].v[2]) / 3.0;
+  std::vector<uint32_t> order(n);
+  std::iota(order.begin(), order.end(), 0u);
+  tree.nodes.reserve(2 * (n / kLeafSize + 1));
+  buildNode(tree, in, order, 0, n);
+  // Triangles in tree order, then each node's expansion over its range.
+  in.corners.resize(n);
+  in.areaNormal.resize(n);
+  std::vector<Vec3> centroid(n);
+  for (uint32_t t = 0; t < n; ++t) {
+    const Triangle& tri = triangles[order[t]];
+    in.corners[t] = tri.v;
+    in.areaNormal[t] = cross(tri.v[1] - tri.v[0], tri.v[2] - tri.v[0]) * 0.5;
+    centroid[t] = in.centroid[order[t]];
+  }
+  in.centroid = std::move(centroid);
+  for (WindingTree::Node& node : tree.nodes) summarize(node, in);
+  tree.corners = std::move(in.corners);
+  return tree;
+}
+
+// The far field of a node is the double-layer potential of its triangles, n.(x - q)/|x - q|^3 integrated over the
+// surface; Taylor-expanded around the node's centre r = center - q it is
+//   normalSum . r / |r|^3  +  sum_ij moment_ij (delta_ij / |r|^3 - 3 r_i r_j / |r|^5)     (Barill et al. eq. 8).
+double windingNumber(const WindingTree& tree, const Vec3& q, double beta) {
+  double w = 0;
+  uint32_t i = 0;
+  const uint32_t end = uint32_t(tree.nodes.size());
+  while (i < end) {
+    const WindingTree::Node& n = tree.nodes[i];
+    const Vec3 r = n.center - q;
+    const double d2 = dot(r, r);
+    if (d2 > beta * beta * n.radius * n.radius) {
+      const double inv = 1 / std::sqrt(d2), inv3 = inv * inv * inv, inv5 = inv3 * inv * inv;
+      double order2 = (n.moment[0] + n.moment[4] + n.moment[8]) * inv3;
+      double rmr = 0;
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) rmr += r[a] * n.moment[a * 3 + b] * r[b];
+      order2 -= 3 * rmr * inv5;
+      w += (dot(n.normalSum, r) * inv3 + order2) * kInv4Pi;
+      i = n.skip;
+    } else if (n.skip == i + 1) {  // a leaf too close for its expansion: its triangles exactly
+      for (uint32_t t = n.first; t < n.first + n.count; ++t)
+        w += triangleWindingNumber(tree.corners[t][0], tree.corners[t][1], tree.corners[t][2], q);
+      i = n.skip;
+    } else {
+      ++i;
+    }
+  }
+  return w;
+}
+
+}  // namespace vox

@@ -5,6 +5,7 @@ set -euo pipefail
 packages=(build-essential cmake ninja-build pkg-config python3
   libcgal-dev libopenmesh-dev libopenimageio-dev libtinygltf-dev libstb-dev nlohmann-json3-dev
   libtbb-dev libcli11-dev libgtest-dev
+  openmpi-bin libopenmpi-dev
   libopenvdb-dev)  # vox-export writes .vdb (export/vdb_writer.cpp)
 for arg in "$@"; do
   case $arg in

@@ -129,9 +129,9 @@ TEST(Bricks, CandidateListsAreRefusedBeforeTheyOutgrowMemory) {
   s.materials.push_back({});
   s.triangles.push_back(tri({0, 0, 0}, {1, 1, 1}, {1, 0, 0}));
   VoxelizeOptions o;
-  o.dims = std::array<uint32_t, 3>{128, 128, 128};
+  o.dims = std::array<uint32_t, 3>{64, 64, 64};
   const Grid plan = planGrid(s, o);
-  EXPECT_THROW(brickCandidates(s, plan, {128, 128, 128}, 1 << 20), LimitError);
+  EXPECT_THROW(brickCandidates(s, plan, {64, 64, 64}, 1 << 20), LimitError);
 }
 
 }  // namespace

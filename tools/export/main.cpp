@@ -8,6 +8,7 @@
 #include "vox/io/atomic_file.h"
 #include "vox/core/error.h"
 #include "vox/io/grid_file.h"
+#include "vox/io/grid_set.h"
 #include "vox/core/progress.h"
 #include "vox/export/voxel_mesh.h"
 #include "vox/export/voxel_format.h"
@@ -36,7 +37,7 @@ int runVoxelFormat(const Options& opt, vox::VoxelFormat format) {
   checkOutputPath(opt.output, {opt.grid});
   const ColorMode color = parseColorMode(opt.color);
   ProgressBar bar("exporting", opt.common.quiet);
-  const GridFile file = readGridFile(opt.grid);
+  const GridFile file = readGridOrSet(opt.grid);
   bar.update(0.1);
   std::vector<Rgb8> colors;
   if (format == VoxelFormat::MagicaVoxel && color != ColorMode::None)
@@ -88,7 +89,7 @@ int run(const Options& opt) {
   const ColorMode color = parseColorMode(opt.color);
 
   ProgressBar bar("exporting", opt.common.quiet);
-  const GridFile file = readGridFile(opt.grid);
+  const GridFile file = readGridOrSet(opt.grid);
   bar.update(0.2);
   VoxelMeshStats stats;
   const auto buildStart = std::chrono::steady_clock::now();

@@ -3,6 +3,7 @@
 
 #include "../common/cli.h"
 #include "vox/io/grid_file.h"
+#include "vox/io/grid_set.h"
 #include "vox/io/info.h"
 
 int main(int argc, char** argv) {
@@ -19,7 +20,7 @@ int main(int argc, char** argv) {
   vox::cli::addCommonOptions(app, common);
   if (auto code = vox::cli::parse(app, argc, argv)) return *code;
   return vox::runTool("vox-info", [&] {
-    const vox::GridFile file = vox::readGridFile(path);
+    const vox::GridFile file = vox::readGridOrSet(path);
     const std::string text = vox::formatGridInfo(file, options);
     std::fwrite(text.data(), 1, text.size(), stdout);
     return std::fflush(stdout) == 0 ? vox::kExitOk : vox::kExitCannotWrite;

@@ -9,6 +9,7 @@
 #include "vox/trace/accel.h"
 #include "vox/core/error.h"
 #include "vox/io/grid_file.h"
+#include "vox/io/grid_set.h"
 #include "vox/io/image_io.h"
 #include "vox/core/progress.h"
 #include "vox/trace/render.h"
@@ -78,7 +79,7 @@ int run(const Options& opt) {
   checkOutputPath(opt.output, {opt.grid});
   ro.samples = opt.samples;
 
-  const GridFile file = readGridFile(opt.grid);
+  const GridFile file = readGridOrSet(opt.grid);
   ro.camera = resolveCamera(opt, file);
   const Accel accel = buildAccel(file.scene, file.grid, accelKind);
 

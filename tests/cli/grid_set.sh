@@ -1,0 +1,131 @@
+#!/usr/bin/env bash
+# Grid sets (vox-voxelize --bricks, issue 13) as a user runs them: vox-info, vox-trace and vox-export give the same
+# output for the set as for the single grid; a bad set or a failed write gives one line, the right exit code and no
+# manifest. Usage: grid_set.sh BUILD_DIR SOURCE_DIR
+set -u
+BIN=$1
+SRC=$2
+SEED=$SRC/../shared/seed-scenes
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
+fails=0
+passes=0
+check() {  # check NAME EXPECTED_CODE COMMAND...
+  local name=$1 expected=$2
+  shift 2
+  "$@" >"$T/out" 2>"$T/err"
+  local code=$?
+  if [ "$code" != "$expected" ]; then
+    echo "FAIL $name: exit $code, expected $expected"; cat "$T/err"; fails=$((fails + 1))
+  else
+    passes=$((passes + 1))
+  fi
+}
+expect_err() {  # expect_err NAME PATTERN: stderr has exactly one line and it matches
+  if [ "$(wc -l <"$T/err")" != 1 ] || ! grep -q -- "$2" "$T/err"; then
+    echo "FAIL $1: stderr should be one line matching '$2':"; cat "$T/err"; fails=$((fails + 1))
+  else
+    passes=$((passes + 1))
+  fi
+}
+same() {  # same NAME FILE1 FILE2
+  if cmp -s "$2" "$3"; then passes=$((passes + 1)); else echo "FAIL $1: $2 and $3 differ"; fails=$((fails + 1)); fi
+}
+
+V=$BIN/vox-voxelize
+I=$BIN/vox-info
+TR=$BIN/vox-trace
+E=$BIN/vox-export
+# Sanitized builds run the same checks on fewer brick counts.
+SANITIZED=0
+grep -q "VOX_SANITIZE:BOOL=ON" "$BIN/CMakeCache.txt" 2>/dev/null && SANITIZED=1
+
+check help 0 "$V" --help
+grep -q -- "--bricks" "$T/out" || { echo "FAIL help lacks --bricks"; fails=$((fails + 1)); }
+
+# Spheres, a squashed sphere (ellipsoid), triangles, planes (never in cells), user bounds cutting primitives off.
+compare_set() {  # compare_set TAG SCENE "GRID ARGS" "BRICKS"
+  local tag=$1 scene=$2 args=$3 bricks=$4
+  check "$tag single" 0 "$V" "$scene" -o "$T/$tag.vgrid" $args -q
+  check "$tag set" 0 "$V" "$scene" -o "$T/${tag}_set.vgrid" $args --bricks $bricks -q
+  check "$tag info" 0 "$I" "$T/$tag.vgrid" --json --cells --primitives
+  mv "$T/out" "$T/$tag.json"
+  check "$tag set info" 0 "$I" "$T/${tag}_set.vgrid" --json --cells --primitives
+  same "$tag: vox-info --json --cells of set and grid" "$T/$tag.json" "$T/out"
+}
+S=$SRC/scenes
+compare_set spheres "$S/scene5_02_spheres.txt" "--grid 15 15 3" "7 5 3"
+compare_set plane "$S/scene6_03_sphere_plane.txt" "--grid 9 8 7" "2 3 1"
+compare_set squashed "$S/scene2_13_rotated_squashed_sphere.txt" "--grid 6 5 4" "6 5 4"  # bricks of one cell
+compare_set bounds "$S/scene5_05_sphere_triangles.txt" "--grid 12 10 8 --bounds -0.5 -0.6 -0.4 0.7 0.5 0.6" "5 3 2"
+compare_set sat "$S/scene5_11_rotated_triangles.txt" "--grid 11 9 7 --method sat" "3 4 2"
+compare_set bbox "$S/scene5_07_bunny_mesh_1k.txt" "--grid 15 15 12 --method bbox" "4 4 4"
+if [ $SANITIZED = 0 ]; then
+  for b in "1 1 1" "1 5 1" "7 5 3"; do
+    compare_set "bunny_${b// /x}" "$S/scene5_07_bunny_mesh_1k.txt" "--grid 15 15 12" "$b"
+  done
+fi
+# Bricks are files of their own, named by the manifest, inside NAME.bricks/ beside it.
+[ "$(ls "$T/spheres_set.bricks" | wc -l)" -ge 2 ] || { echo "FAIL brick files"; fails=$((fails + 1)); }
+
+# Traced images and exported meshes of a set equal those of the single grid, byte for byte.
+for mode in shade voxels count normals depth; do
+  check "trace $mode" 0 "$TR" "$T/spheres.vgrid" -o "$T/a_$mode.png" --size 64 48 --mode $mode -q
+  check "trace set $mode" 0 "$TR" "$T/spheres_set.vgrid" -o "$T/b_$mode.png" --size 64 48 --mode $mode -q
+  same "trace $mode of set and grid" "$T/a_$mode.png" "$T/b_$mode.png"
+done
+check "trace plane" 0 "$TR" "$T/plane.vgrid" -o "$T/a_plane.png" --size 64 48 -q
+check "trace plane set" 0 "$TR" "$T/plane_set.vgrid" -o "$T/b_plane.png" --size 64 48 -q
+same "trace of a set with a plane" "$T/a_plane.png" "$T/b_plane.png"
+for faces in all exposed merged; do
+  check "export $faces" 0 "$E" "$T/bbox.vgrid" -o "$T/a_$faces.ply" --faces $faces -q
+  check "export set $faces" 0 "$E" "$T/bbox_set.vgrid" -o "$T/b_$faces.ply" --faces $faces -q
+  same "export $faces of set and grid" "$T/a_$faces.ply" "$T/b_$faces.ply"
+done
+
+# A scene of planes only: no occupied cell, yet the set keeps its scene (one empty brick file).
+printf 'OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 5 }\nLights { numLights 1 DirectionalLight { direction 0 0 -1 color 1 1 1 } }\nBackground { color 0 0 0 ambientLight 0.2 0.2 0.2 }\nMaterials { numMaterials 1 Material { diffuseColor 1 0 0 } }\nGroup { numObjects 1 MaterialIndex 0 Plane { normal 0 1 0 offset -1 } }\n' >"$T/planes.txt"
+check "planes only single" 0 "$V" "$T/planes.txt" -o "$T/p.vgrid" -q
+check "planes only set" 0 "$V" "$T/planes.txt" -o "$T/p_set.vgrid" --bricks 1 1 1 -q
+check "planes trace" 0 "$TR" "$T/p.vgrid" -o "$T/p1.png" --size 32 32 -q
+check "planes set trace" 0 "$TR" "$T/p_set.vgrid" -o "$T/p2.png" --size 32 32 -q
+same "planes-only set traces as its grid" "$T/p1.png" "$T/p2.png"
+
+# Usage errors: one line, exit 1, nothing written.
+check "fill with bricks" 1 "$V" "$S/scene5_01_sphere.txt" -o "$T/f.vgrid" --bricks 2 2 2 --fill
+expect_err "fill with bricks" "fill cannot be combined with --bricks"
+check "more bricks than cells" 1 "$V" "$S/scene5_01_sphere.txt" -o "$T/f.vgrid" --grid 4 4 4 --bricks 5 1 1
+expect_err "more bricks than cells" "5 bricks on axis x"
+check "zero bricks" 1 "$V" "$S/scene5_01_sphere.txt" -o "$T/f.vgrid" --bricks 0 1 1
+[ ! -e "$T/f.vgrid" ] || { echo "FAIL usage error left a manifest"; fails=$((fails + 1)); }
+
+# A brick folder that cannot be made: exit 3, no manifest.
+touch "$T/blocked.bricks"
+check "brick folder blocked" 3 "$V" "$S/scene5_01_sphere.txt" -o "$T/blocked.vgrid" --grid 8 8 8 --bricks 2 2 2
+expect_err "brick folder blocked" "blocked.bricks"
+[ ! -e "$T/blocked.vgrid" ] || { echo "FAIL failed set left a manifest"; fails=$((fails + 1)); }
+# A brick that cannot be written (a folder in its place): exit 3, no manifest.
+mkdir -p "$T/stuck.bricks/b_0_0_0.vgrid"
+check "brick write fails" 3 "$V" "$S/scene5_01_sphere.txt" -o "$T/stuck.vgrid" --grid 8 8 8 --bricks 2 2 2
+expect_err "brick write fails" "b_0_0_0.vgrid"
+[ ! -e "$T/stuck.vgrid" ] || { echo "FAIL failed brick left a manifest"; fails=$((fails + 1)); }
+
+# Bad sets: one line naming the file, exit 2.
+cp "$T/spheres_set.vgrid" "$T/bad.vgrid"
+printf '\x01' | dd of="$T/bad.vgrid" bs=1 seek=40 conv=notrunc 2>/dev/null
+check "corrupt manifest" 2 "$I" "$T/bad.vgrid"
+expect_err "corrupt manifest" "bad.vgrid: byte .*checksum"
+head -c 50 "$T/spheres_set.vgrid" >"$T/short.vgrid"
+check "truncated manifest" 2 "$I" "$T/short.vgrid"
+expect_err "truncated manifest" "short.vgrid: truncated"
+first=$(ls "$T/spheres_set.bricks" | head -1)
+mv "$T/spheres_set.bricks/$first" "$T/moved.vgrid"
+check "missing brick" 2 "$TR" "$T/spheres_set.vgrid" -o "$T/m.png"
+expect_err "missing brick" "$first"
+[ ! -e "$T/m.png" ] || { echo "FAIL image written from a broken set"; fails=$((fails + 1)); }
+cp "$T/squashed.vgrid" "$T/spheres_set.bricks/$first"  # another grid in its place
+check "foreign brick" 2 "$E" "$T/spheres_set.vgrid" -o "$T/m.ply"
+expect_err "foreign brick" "not the brick"
+
+echo "grid_set.sh: $passes passed, $fails failed"
+[ $fails = 0 ]

@@ -49,6 +49,13 @@ for mode in shade normals depth; do
   "$TRACE" "$WORK/b.vgrid" -o "$WORK/n_$mode.png" --size 40 40 --mode $mode --accel none -q || fail "$mode none"
   cmp -s "$WORK/g_$mode.png" "$WORK/n_$mode.png" || fail "$mode: grid and none images differ"
 done
+# The course's recursive lines (issue 12): the glass sphere with its flags, grid and brute force the same file.
+"$VOXELIZE" "$SEED/scene6_14_glass_sphere.txt" -o "$WORK/g.vgrid" --grid 20 20 20 -q || fail "voxelize glass sphere"
+for accel in grid none; do
+  expect 0 "glass sphere $accel" -- "$TRACE" "$WORK/g.vgrid" -o "$WORK/glass_$accel.png" --size 32 32 --shade-back \
+    --bounces 5 --weight 0.01 --samples 4 --filter gaussian 0.4 --accel $accel -q
+done
+cmp -s "$WORK/glass_grid.png" "$WORK/glass_none.png" || fail "glass sphere: grid and none images differ"
 expect 0 "count mode prints its scale" -- "$TRACE" "$WORK/b.vgrid" -o "$WORK/c.png" --size 20 20 --mode count --stats -q
 grep -Eq '^count_scale_max: [0-9.]+$' "$WORK/err.txt" || fail "count mode: no count_scale_max line"
 expect 0 "depth to EXR" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/d.exr" --size 20 20 --mode depth -q
@@ -102,6 +109,13 @@ expect 1 "eye without look-at" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.png"
 expect 1 "NaN eye" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.png" --eye nan 0 1 --look-at 0 0 0 -q
 grep -q "must be finite" "$WORK/err.txt" || fail "NaN eye: message does not say the eye must be finite"
 expect 1 "unknown image format" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.xyz" -q
+expect 1 "negative weight" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.png" --weight -1 -q
+expect 1 "NaN weight" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.png" --weight nan -q
+expect 1 "bounces 1000" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.png" --bounces 1000 -q
+expect 1 "unknown filter" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.png" --filter sinc 1 -q
+expect 1 "filter radius 0" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.png" --filter box 0 -q
+expect 1 "filter radius not a number" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.png" --filter tent x -q
+expect 1 "filter without radius" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.png" --filter gaussian -q
 expect 1 "no output" -- "$TRACE" "$WORK/s.vgrid" -q
 
 # Unwritable outputs: missing folder, a file used as a folder, a folder as the output, a read-only folder.

@@ -2,6 +2,7 @@
 #include <tbb/info.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 
 #include "../common/cli.h"
@@ -19,6 +20,8 @@ namespace {
 constexpr uint32_t kMaxSide = 16384;
 constexpr uint64_t kMaxPixels = uint64_t(1) << 28;
 constexpr uint32_t kMaxSamples = 4096;
+// Reflected and refracted rays double at most per bounce: 2^20 paths per sample is already far beyond use.
+constexpr uint32_t kMaxBounces = 20;
 
 struct Options {
   std::string grid;
@@ -27,6 +30,10 @@ struct Options {
   std::string mode = "shade";
   std::string accel = "grid";
   uint32_t samples = 1;
+  uint32_t bounces = 0;
+  double weight = 0.01;
+  bool shadeBack = false, noShadows = false;
+  std::vector<std::string> filter;  // KIND RADIUS
   bool stats = false;
   std::vector<double> eye, lookAt, up;
   double fov = 0;  // 0: not given
@@ -78,6 +85,20 @@ int run(const Options& opt) {
     fail<UsageError>(opt.output, ": unknown image format (use an extension such as .png, .tga, .exr, .jpg)");
   checkOutputPath(opt.output, {opt.grid});
   ro.samples = opt.samples;
+  ro.bounces = opt.bounces;
+  ro.weight = opt.weight;
+  ro.shadeBack = opt.shadeBack;
+  ro.shadows = !opt.noShadows;
+  if (!(std::isfinite(opt.weight) && opt.weight >= 0)) fail<UsageError>("--weight must be a finite number >= 0");
+  if (opt.bounces > kMaxBounces) fail<UsageError>("--bounces must be 0..", kMaxBounces);
+  if (!opt.filter.empty()) {
+    ro.filter = parseFilter(opt.filter[0]);
+    char* end = nullptr;
+    ro.filterRadius = std::strtod(opt.filter[1].c_str(), &end);
+    if (end == opt.filter[1].c_str() || *end != 0 || !(ro.filterRadius > 0 && ro.filterRadius <= kMaxFilterRadius))
+      fail<UsageError>("--filter ", opt.filter[0], " '", opt.filter[1], "': the radius must be a number in (0, ",
+                       kMaxFilterRadius, "] pixels");
+  }
 
   const GridFile file = readGridOrSet(opt.grid);
   ro.camera = resolveCamera(opt, file);
@@ -123,6 +144,12 @@ int main(int argc, char** argv) {
                  "depth (distance along the unit ray; float in EXR/TIFF, grey near-bright otherwise)");
   app.add_option("--accel", opt.accel, "grid (walk the grid) or none (test every primitive)");
   app.add_option("--samples", opt.samples, "Jittered samples per pixel (stratified when a square number)");
+  app.add_option("--bounces", opt.bounces, "Shade mode: reflection and refraction depth (default 0, the course's)");
+  app.add_option("--weight", opt.weight, "Shade mode: stop a path whose contribution falls under W (default 0.01)");
+  app.add_flag("--shade-back", opt.shadeBack, "Shade mode: light back faces too (without it they are black)");
+  app.add_flag("--no-shadows", opt.noShadows, "Shade mode: no shadow rays (the course's lines without -shadows)");
+  app.add_option("--filter", opt.filter, "Reconstruction filter KIND RADIUS: box, tent or gaussian, radius in pixels")
+      ->expected(2);
   app.add_flag("--stats", opt.stats, "Print statistics (name: value) on stderr");
   auto* eye = app.add_option("--eye", opt.eye, "Camera position X Y Z (with --look-at: a perspective camera)")->expected(3);
   auto* look = app.add_option("--look-at", opt.lookAt, "Point the camera looks at X Y Z")->expected(3);

@@ -3,6 +3,7 @@
 #include <cfloat>
 
 #include "vox/core/error.h"
+#include "vox/core/material_at.h"
 
 namespace vox {
 
@@ -70,6 +71,7 @@ void validateMaterial(const Material& m, size_t i, const std::string& source) {
 void validateScene(const Scene& scene, const std::string& source) {
   const size_t materials = scene.materials.size();
   for (size_t i = 0; i < materials; ++i) validateMaterial(scene.materials[i], i, source);
+  validateSolidTextures(scene, source);
   validateTextures(scene, source);
   auto checkMaterial = [&](uint32_t m, const char* what, size_t i) {
     if (m >= materials) fail<InputError>(source, ": ", what, " ", i, ": material index ", m, " out of range");

@@ -288,23 +288,26 @@ class CourseParser {
     const long long n = readCount();
     // A Materials block replaces any earlier one, as the course's parser keeps only the last.
     std::vector<Material> materials;
+    std::vector<SolidTexture> solidTextures;
     for (long long i = 0; i < n; ++i) {
       const Token t = next("a material");
       if (t.text == "Material" || t.text == "PhongMaterial") {
         materials.push_back(parsePhong());
       } else if (t.text == "Checkerboard" || t.text == "Noise" || t.text == "Marble" || t.text == "Wood") {
-        const uint32_t first = parseProcedural(t, materials.size());
-        Material m = materials[first];
+        const SolidTexture texture = parseSolidTexture(t, materials.size());
+        // The plain fields are the first material's: what tools that draw one colour per material show.
+        Material m = materials[texture.materials[0]];
         m.name = std::string(t.text);
+        m.solidTexture = uint32_t(solidTextures.size());
+        solidTextures.push_back(texture);
         materials.push_back(m);
-        warn(path_, ":", t.line, ": ", t.text, " material ", i,
-             " is drawn in the colour of its first material (procedural textures are not supported)");
       } else {
         failAt(t, "unknown material '", t.text, "'");
       }
     }
     expect("}");
     scene_.materials = std::move(materials);
+    scene_.solidTextures = std::move(solidTextures);
   }
 
   Material parsePhong() {
@@ -331,35 +334,51 @@ class CourseParser {
     return m;
   }
 
-  // Reads a Checkerboard/Noise/Marble/Wood block fully and returns its first material index.
-  uint32_t parseProcedural(const Token& kind, size_t definedSoFar) {
+  // Reads a Checkerboard/Noise/Marble/Wood block. Its materialIndex fields must name materials defined before it,
+  // so textures cannot form cycles; their nesting depth is checked by validateScene.
+  SolidTexture parseSolidTexture(const Token& kind, size_t definedSoFar) {
+    SolidTexture texture;
+    texture.kind = kind.text == "Checkerboard" ? SolidKind::Checkerboard
+                   : kind.text == "Noise"      ? SolidKind::Noise
+                   : kind.text == "Marble"     ? SolidKind::Marble
+                                               : SolidKind::Wood;
     expect("{");
-    std::vector<uint32_t> indices;
+    size_t indices = 0;
     for (;;) {
       const Token t = next("'}'");
       if (t.text == "}") break;
       if (t.text == "Transform") {
         expect("{");
-        Mat4 ignored;  // maps world points to texture space; no use without the texture
-        parseTransformOps(ignored);
+        parseTransformOps(texture.transform);  // world points to texture space
         expect("}");
       } else if (t.text == "materialIndex") {
         const Token at = here();
         const long long k = readInteger();
         if (k < 0 || static_cast<size_t>(k) >= definedSoFar)
           failAt(at, "materialIndex ", k, " does not name a material defined before it (", definedSoFar, " so far)");
-        indices.push_back(static_cast<uint32_t>(k));
-      } else if (t.text == "octaves" && kind.text != "Checkerboard") {
-        const Token at = here();
-        if (readInteger() < 0) failAt(at, "negative octaves");
-      } else if ((t.text == "frequency" || t.text == "amplitude") && (kind.text == "Marble" || kind.text == "Wood")) {
-        readDouble();
+        if (indices == 2) failAt(t, kind.text, " has more than two materialIndex fields");
+        texture.materials[indices++] = static_cast<uint32_t>(k);
       } else {
-        failAt(t, "unknown ", kind.text, " field '", t.text, "'");
+        parseSolidTextureNumber(kind, t, texture);
       }
     }
-    if (indices.size() != 2) failAt(kind, kind.text, " needs two materialIndex fields, found ", indices.size());
-    return indices[0];
+    if (indices != 2) failAt(kind, kind.text, " needs two materialIndex fields, found ", indices);
+    return texture;
+  }
+
+  void parseSolidTextureNumber(const Token& kind, const Token& t, SolidTexture& texture) {
+    if (t.text == "octaves" && kind.text != "Checkerboard") {
+      const Token at = here();
+      const long long n = readInteger();
+      if (n < 0 || n > kMaxOctaves) failAt(at, "octaves ", n, " out of range (0..", kMaxOctaves, ")");
+      texture.octaves = uint32_t(n);
+    } else if (t.text == "frequency" && (kind.text == "Marble" || kind.text == "Wood")) {
+      texture.frequency = readDouble();
+    } else if (t.text == "amplitude" && (kind.text == "Marble" || kind.text == "Wood")) {
+      texture.amplitude = readDouble();
+    } else {
+      failAt(t, "unknown ", kind.text, " field '", t.text, "'");
+    }
   }
 
   // ---- transforms ----

@@ -10,6 +10,8 @@
 #include <cmath>
 
 #include "vox/core/error.h"
+#include "trace/pixel_filter.h"
+#include "trace/shade.h"
 #include "vox/trace/trace_packet.h"
 
 #if __has_include("vox/colormap.h")
@@ -90,51 +92,17 @@ uint64_t splitMix(uint64_t& state) {
 }
 double uniform(uint64_t& state) { return double(splitMix(state) >> 11) * 0x1.0p-53; }
 
-uint32_t materialOf(const Scene& scene, const Accel& accel, uint32_t prim) {
-  if (prim < accel.triangleCount) return scene.triangles[prim].material;
-  prim -= accel.triangleCount;
-  if (prim < accel.sphereCount) return scene.spheres[prim].material;
-  return scene.planes[prim - accel.sphereCount].material;
-}
-
-Vec3 normalOf(const Accel& accel, const Ray& ray, const Hit& hit) {
-  uint32_t prim = hit.prim;
-  if (prim < accel.triangleCount) return triangleNormal(accel.triangles[prim]);
-  prim -= accel.triangleCount;
-  if (prim < accel.sphereCount) return sphereNormal(accel.spheres[prim], ray, hit.t);
-  return planeNormal(accel.planes[prim - accel.sphereCount]);
-}
-
-struct LightSetup {
-  std::vector<Light> lights;
-  bool castShadows = true;
-};
-
-LightSetup lightsFor(const Scene& scene, const Frame& frame) {
-  LightSetup s;
-  s.lights = scene.lights;
-  if (s.lights.empty()) {
+// The lights of the shade mode: the scene's, or a headlight (which casts no shadow: its shadows hide behind what
+// casts them).
+void setLights(Shader& shader, const Scene& scene, const Frame& frame) {
+  shader.lights = scene.lights;
+  if (shader.lights.empty()) {
     Light head;
     head.kind = LightKind::Directional;
     head.direction = frame.dir;
-    s.lights.push_back(head);
-    s.castShadows = false;  // a headlight's shadows hide behind what casts them
+    shader.lights.push_back(head);
+    shader.castShadows = false;
   }
-  return s;
-}
-
-// Direction towards the light (unit), distance to it (infinite for directional) and the attenuated colour.
-struct LightSample {
-  Vec3 toLight;
-  double distance;
-  Vec3 color;
-};
-LightSample sampleLight(const Light& light, const Vec3& p) {
-  if (light.kind == LightKind::Directional) return {normalize(-light.direction), kInfinity, light.color};
-  const Vec3 d = light.position - p;
-  const double dist = length(d);
-  const double att = light.attenuation.x + light.attenuation.y * dist + light.attenuation.z * dist * dist;
-  return {dist > 0 ? d / dist : Vec3{0, 0, 1}, dist, att > 0 ? light.color / att : light.color};
 }
 
 struct Renderer {
@@ -142,59 +110,25 @@ struct Renderer {
   const Accel& accel;
   const RenderOptions& options;
   Frame frame;
-  LightSetup lights;
-  double sceneSize = 1;
+  Shader shader;
   uint32_t maxCellPrims = 1;
 
-  // Ambient, diffuse and Blinn-Phong specular with shadow rays. The normal is turned to face the viewer, so
-  // triangles are two-sided and the inside of a sphere is lit like the outside.
-  // `visible(light index, shadow ray)` answers whether the light is seen; it is asked only for lights in front of
-  // the surface, and only when lights cast shadows.
-  template <typename Visible>
-  Vec3 shade(const Ray& ray, const Hit& hit, Visible&& visible) const {
-    const Material& mat = scene.materials[std::min<size_t>(materialOf(scene, accel, hit.prim), scene.materials.size() - 1)];
-    const Vec3 p = ray.origin + ray.direction * hit.t;
-    Vec3 n = normalOf(accel, ray, hit);
-    if (dot(n, ray.direction) > 0) n = -n;
-    const Vec3 view = normalize(-ray.direction);
-    Vec3 color = mul(scene.ambient, mat.diffuse);
-    // Shadow rays start off the surface by a hair relative to the scene and to the magnitude of p.
-    const double pMag = std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
-    const double eps = 1e-7 * sceneSize + 64 * std::numeric_limits<double>::epsilon() * pMag;
-    for (size_t li = 0; li < lights.lights.size(); ++li) {
-      const LightSample ls = sampleLight(lights.lights[li], p);
-      const double nl = dot(n, ls.toLight);
-      if (nl <= 0) continue;
-      if (lights.castShadows) {
-        Ray shadow;
-        shadow.origin = p + n * eps;
-        shadow.direction = ls.toLight;
-        shadow.tMin = eps;
-        shadow.tMax = ls.distance - eps;
-        if (shadow.tMax > shadow.tMin && !visible(li, shadow)) continue;
-      }
-      Vec3 c = mat.diffuse * nl;
-      if (mat.specular.x > 0 || mat.specular.y > 0 || mat.specular.z > 0) {
-        const double nh = dot(n, normalize(ls.toLight + view));
-        if (nh > 0) c = c + mat.specular * std::pow(nh, mat.exponent);
-      }
-      color = color + mul(c, ls.color);
-    }
-    return color;
-  }
-
   // The shade mode for a packet of primary rays and their hits: the shadow rays of each light are traced as packets
-  // too (they start near each other and end at one light, or run parallel). Writes RGB for each ray into out.
+  // too (they start near each other and end at one light, or run parallel); reflected and refracted rays, and the
+  // shadow rays where they land, are traced one by one (Shader::secondary). Writes RGB for each ray into out.
   void shadePacket(std::span<const Ray> rays, std::span<const Hit> hits, float (*out)[3], TraceStats& st) const {
-    const size_t lightCount = lights.lights.size();
+    const size_t lightCount = shader.lights.size();
+    std::vector<Surface> surfaces(rays.size());
+    for (size_t r = 0; r < rays.size(); ++r)
+      if (hits[r].valid()) surfaces[r] = shader.surface(rays[r], hits[r]);
     // First pass: collect the shadow rays, per light, with the slot of their answer (ray * lightCount + light). It
     // runs the shading itself, so that the rays asked for are exactly those the second pass will ask about.
     std::vector<std::vector<Ray>> shadowRays(lightCount);
     std::vector<std::vector<uint32_t>> slots(lightCount);
     std::vector<uint8_t> seen(rays.size() * lightCount, 1);
-    for (size_t r = 0; r < rays.size() && lights.castShadows; ++r) {
+    for (size_t r = 0; r < rays.size() && shader.castShadows; ++r) {
       if (!hits[r].valid()) continue;
-      shade(rays[r], hits[r], [&](size_t li, const Ray& shadow) {
+      shader.local(rays[r], surfaces[r], [&](size_t li, const Ray& shadow) {
         shadowRays[li].push_back(shadow);
         slots[li].push_back(uint32_t(r * lightCount + li));
         return true;
@@ -207,10 +141,12 @@ struct Renderer {
         occludedPacket(accel, std::span(shadowRays[li]).subspan(begin, count), {blocked, count}, &st);
         for (size_t i = 0; i < count; ++i) seen[slots[li][begin + i]] = !blocked[i];
       }
-    // Second pass: shade with the answers.
+    // Second pass: shade with the answers, then add what the surface reflects and transmits.
     for (size_t r = 0; r < rays.size(); ++r) {
       const auto answer = [&](size_t li, const Ray&) { return seen[r * lightCount + li] != 0; };
-      const Vec3 c = hits[r].valid() ? shade(rays[r], hits[r], answer) : scene.background;
+      Vec3 c = scene.background;
+      if (hits[r].valid())
+        c = shader.local(rays[r], surfaces[r], answer) + shader.secondary(rays[r], surfaces[r], 0, 1.0, st);
       out[r][0] = float(c.x), out[r][1] = float(c.y), out[r][2] = float(c.z);
     }
   }
@@ -225,7 +161,7 @@ struct Renderer {
     const Vec3 base = cell.solid ? Vec3{0.6, 0.6, 0.6} : voxelColor(cell.primCount, maxCellPrims);
     Vec3 color = mul(scene.ambient, base);
     const Vec3 p = ray.origin + ray.direction * cell.t;
-    for (const Light& light : lights.lights) {
+    for (const Light& light : shader.lights) {
       const LightSample ls = sampleLight(light, p);
       const double nl = dot(n, ls.toLight);
       if (nl > 0) color = color + mul(base * nl, ls.color);
@@ -244,7 +180,7 @@ struct Renderer {
       case RenderMode::Normals: {
         Vec3 c;
         if (hit.valid()) {
-          Vec3 n = normalOf(accel, ray, hit);
+          Vec3 n = hitNormal(accel, ray, hit);
           if (dot(n, ray.direction) > 0) n = -n;
           c = (n + Vec3{1, 1, 1}) * 0.5;
         }
@@ -282,11 +218,15 @@ Ray primaryRay(const Camera& camera, uint32_t width, uint32_t height, double px,
 Image traceImage(const Scene& scene, const Accel& accel, const RenderOptions& options, RenderStats* stats) {
   if (options.width == 0 || options.height == 0) fail<UsageError>("image size must be at least 1x1");
   if (options.samples == 0) fail<UsageError>("samples must be at least 1");
+  if (!std::isfinite(options.weight) || options.weight < 0) fail<UsageError>("weight must be a finite number >= 0");
+  if (options.filter != FilterKind::None && !(options.filterRadius > 0 && options.filterRadius <= kMaxFilterRadius))
+    fail<UsageError>("filter radius must be in (0, ", kMaxFilterRadius, "] pixels");
   if (scene.materials.empty()) fail<InputError>("scene has no material");
-  Renderer r{scene, accel, options, cameraFrame(options.camera), {}, 1, 1};
-  r.lights = lightsFor(scene, r.frame);
+  Renderer r{scene, accel, options, cameraFrame(options.camera), Shader{scene, accel, options, {}, true, 1}, 1};
+  setLights(r.shader, scene, r.frame);
+  r.shader.castShadows = r.shader.castShadows && options.shadows;
   const Box& b = accel.grid->bounds;
-  r.sceneSize = std::max(length(b.hi - b.lo), 1e-300);
+  r.shader.sceneSize = std::max(length(b.hi - b.lo), 1e-300);
   for (size_t c = 0; c < accel.grid->occupiedCount(); ++c)
     r.maxCellPrims = std::max<uint32_t>(r.maxCellPrims, uint32_t(accel.grid->cellPrims(c).size()));
 
@@ -297,6 +237,8 @@ Image traceImage(const Scene& scene, const Accel& accel, const RenderOptions& op
   image.channels = single ? 1 : 3;
   image.pixels.assign(uint64_t(image.width) * image.height * image.channels, 0.0f);
 
+  SampleStore store;
+  if (options.filter != FilterKind::None) store = makeSampleStore(image.width, image.height, options.samples, image.channels);
   const uint32_t strata = uint32_t(std::lround(std::sqrt(double(options.samples))));
   const bool stratified = strata * strata == options.samples;
   tbb::combinable<TraceStats> perThread;
@@ -320,6 +262,7 @@ Image traceImage(const Scene& scene, const Accel& accel, const RenderOptions& op
                 rng[count++] = options.seed ^ ((uint64_t(y) << 32) | x) * 0x9e3779b97f4a7c15ull;
               }
             float sum[kMaxPacketRays][3] = {};
+            double jx[kMaxPacketRays], jy[kMaxPacketRays];
             Ray rays[kMaxPacketRays];
             Hit hits[kMaxPacketRays];
             for (uint32_t s = 0; s < options.samples; ++s) {
@@ -335,6 +278,7 @@ Image traceImage(const Scene& scene, const Accel& accel, const RenderOptions& op
                   }
                 }
                 rays[p] = rayFromFrame(options.camera, r.frame, image.width, image.height, sx, sy);
+                jx[p] = sx - px[p], jy[p] = sy - py[p];
               }
               float value[kMaxPacketRays][3];
               if (r.nearestHitMode()) {
@@ -347,6 +291,8 @@ Image traceImage(const Scene& scene, const Accel& accel, const RenderOptions& op
               }
               for (uint32_t p = 0; p < count; ++p)
                 for (uint32_t c = 0; c < image.channels; ++c) sum[p][c] += value[p][c];
+              if (store.active())
+                for (uint32_t p = 0; p < count; ++p) store.put(px[p], py[p], s, jx[p], jy[p], value[p]);
             }
             for (uint32_t p = 0; p < count; ++p) {
               float* out = image.at(px[p], py[p]);
@@ -359,6 +305,7 @@ Image traceImage(const Scene& scene, const Accel& accel, const RenderOptions& op
           options.progress(double(done) / image.height);
         }
       });
+  if (store.active()) image = filterSamples(store, options.filter, options.filterRadius);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   RenderStats rs;

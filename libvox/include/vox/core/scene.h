@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "vox/core/math.h"
+#include "vox/core/solid_texture.h"
 #include "vox/core/texture.h"
 
 namespace vox {
@@ -21,6 +22,9 @@ struct Material {
   Vec3 reflective{0, 0, 0};
   Vec3 transparent{0, 0, 0};
   double indexOfRefraction = 1;
+  // A solid texture (Scene::solidTextures index) that replaces the fields above by a blend of two other materials
+  // at each point; kNoSolidTexture for a plain Phong material.
+  uint32_t solidTexture = kNoSolidTexture;
   // An image texture (Scene::textures index) whose colour `diffuse` multiplies (glTF baseColorTexture, OBJ
   // map_Kd), over the triangles' Scene::triangleUVs; kNoTexture for none.
   uint32_t diffuseTexture = kNoTexture;
@@ -73,6 +77,7 @@ struct Light {
 
 struct Scene {
   std::vector<Material> materials;  // never empty after import: importers add a default white material
+  std::vector<SolidTexture> solidTextures;  // referenced by Material::solidTexture
   std::vector<Triangle> triangles;
   std::vector<Sphere> spheres;
   std::vector<Plane> planes;

@@ -26,10 +26,28 @@ struct Image {
   const float* at(uint32_t x, uint32_t y) const { return pixels.data() + (uint64_t(y) * width + x) * channels; }
 };
 
+// Reconstruction filters of the course's assignment 7: a pixel is the weighted mean of the samples (its own and
+// its neighbours') within the filter's support around its centre; d is the distance in pixels, r the radius.
+// Box: weight 1 where |dx| < r and |dy| < r; Tent: max(0, 1 - d / r); Gaussian: exp(-d^2 / (2 r^2)) for d < 2r.
+enum class FilterKind : uint8_t { None, Box, Tent, Gaussian };
+// Throws UsageError for a name other than box, tent, gaussian.
+FilterKind parseFilter(const std::string& name);
+// Largest filter radius, in pixels: the filter visits (2 ceil(2r) + 1)^2 pixels' samples per pixel.
+inline constexpr double kMaxFilterRadius = 16;
+
 struct RenderOptions {
   uint32_t width = 512, height = 512;
   RenderMode mode = RenderMode::Shade;
   uint32_t samples = 1;   // per pixel; > 1 jitters inside the pixel (stratified when a square number)
+  // Shade mode, the course's recursive ray tracing (docs/trace.md "Shading"): reflected and refracted rays up to
+  // `bounces` deep, a path stopped when its weight (product of the reflective or transparent colours' largest
+  // component along it) falls under `weight`; back faces black unless `shadeBack`; shadow rays unless !shadows.
+  uint32_t bounces = 0;
+  double weight = 0.01;
+  bool shadeBack = false;
+  bool shadows = true;
+  FilterKind filter = FilterKind::None;  // None: each pixel is the plain mean of its own samples
+  double filterRadius = 0.5;             // pixels
   Camera camera;          // already resolved (scene camera, overrides or defaultCamera)
   uint64_t seed = 0;      // of the per-pixel jitter
   // Called from worker threads with the fraction of rows done; may be empty.
@@ -53,7 +71,8 @@ Ray primaryRay(const Camera& camera, uint32_t width, uint32_t height, double px,
 // Renders `scene` (the scene of accel.grid) in options.mode. Output channels: shade, voxels, count, normals: RGB in
 // [0, 1] (linear, unclamped for shade); depth: one channel, the distance along the unit ray direction to the hit,
 // 0 where nothing is hit. Without lights the scene is lit by a headlight (a directional light along the camera
-// direction, casting no shadow). Throws UsageError for a zero size or sample count.
+// direction, casting no shadow). Throws UsageError for a zero size or sample count, a negative or non-finite
+// weight or filter radius; LimitError when the samples kept for a filter exceed the memory budget.
 Image traceImage(const Scene& scene, const Accel& accel, const RenderOptions& options, RenderStats* stats = nullptr);
 
 // The depth image as grey for 8-bit formats, linear in 1/depth: the nearest hit 1, the farthest 0.15, nothing hit 0.

@@ -392,7 +392,7 @@ TEST(Vdb, DensityAndCountReadBackByOpenVdbInWorldSpace) {
   openvdb::GridPtrVecPtr grids = stream.getGrids();
   ASSERT_EQ(grids->size(), 2u);
   auto density = openvdb::gridPtrCast<openvdb::FloatGrid>(openvdb::findGridByName(*grids, "density"));
-  auto count = openvdb::gridPtrCast<openvdb::Int32Grid>(openvdb::findGridByName(*grids, "count"));
+  auto count = openvdb::gridPtrCast<openvdb::FloatGrid>(openvdb::findGridByName(*grids, "count"));
   ASSERT_TRUE(density && count);
   EXPECT_EQ(density->activeVoxelCount(), cells.size());
   EXPECT_EQ(count->activeVoxelCount(), g.cellKeys.size());
@@ -405,7 +405,7 @@ TEST(Vdb, DensityAndCountReadBackByOpenVdbInWorldSpace) {
   for (size_t c = 0; c < g.cellKeys.size(); ++c) {
     const Cell ijk = cellIndex(g.dims, g.cellKeys[c]);
     EXPECT_EQ(count->tree().getValue(openvdb::Coord(int(ijk[0]), int(ijk[1]), int(ijk[2]))),
-              int(g.cellStart[c + 1] - g.cellStart[c]));
+              float(g.cellStart[c + 1] - g.cellStart[c]));
   }
   // Index (i, j, k) is the centre of cell (i, j, k); the cell's corners are the grid's boundaries.
   const openvdb::Vec3d centre = density->transform().indexToWorld(openvdb::Vec3d(3, 5, 7));

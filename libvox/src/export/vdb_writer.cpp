@@ -66,13 +66,15 @@ openvdb::FloatGrid::Ptr buildDensity(const Grid& grid, const std::function<void(
   return density;
 }
 
-openvdb::Int32Grid::Ptr buildCount(const Grid& grid) {
-  auto count = openvdb::Int32Grid::create(0);
+// A float grid, not Int32Grid: pyopenvdb (Debian's python3-openvdb) refuses to read files holding int32 grids, and
+// counts below 2^24 are exact in float.
+openvdb::FloatGrid::Ptr buildCount(const Grid& grid) {
+  auto count = openvdb::FloatGrid::create(0.0f);
   auto acc = count->getAccessor();
   for (size_t c = 0; c < grid.cellKeys.size(); ++c) {
     const auto ijk = cellIndex(grid.dims, grid.cellKeys[c]);
     acc.setValueOn(openvdb::Coord(int(ijk[0]), int(ijk[1]), int(ijk[2])),
-                   int32_t(grid.cellStart[c + 1] - grid.cellStart[c]));
+                   float(grid.cellStart[c + 1] - grid.cellStart[c]));
   }
   return count;
 }

@@ -18,7 +18,8 @@ struct VdbStats {
 // Writes `grid` as an OpenVDB file (OpenVDB 10, the library's default compression) holding two grids:
 //  - `density` (FloatGrid, class fog volume): 1 in every occupied and solid cell, active there, 0 and inactive
 //    elsewhere; uniform blocks are stored as tiles, so a filled interior costs little;
-//  - `count` (Int32Grid): the number of primitives held by each occupied cell (solid-only cells are not in it).
+//  - `count` (FloatGrid, a float so that pyopenvdb reads the file): the number of primitives held by each occupied
+//    cell (solid-only cells are not in it).
 // Both carry the grid's exact per-axis voxel transform (a ScaleTranslateMap): index (i, j, k) is the centre of cell
 // (i, j, k), world = lo + (index + 0.5) * (hi - lo) / n on each axis, so non-cubic cells keep their shape.
 // Memory grows with the occupied cells and the solid runs' surface, not with the solid volume: the solid interior

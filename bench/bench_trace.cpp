@@ -26,6 +26,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <functional>
 #include <memory>
 #include <string>
@@ -48,10 +49,10 @@ struct Method {
   std::string name;
   std::function<void()> run;
   double best = 1e30;
-  std::vector<double> times;
+  std::vector<double> times, cpuTimes;  // wall seconds; process CPU seconds (what a loaded machine distorts less)
 
-  double median() const {
-    std::vector<double> t = times;
+  double median(bool cpu = false) const {
+    std::vector<double> t = cpu ? cpuTimes : times;
     std::sort(t.begin(), t.end());
     return t.empty() ? 0 : t.size() % 2 ? t[t.size() / 2] : (t[t.size() / 2 - 1] + t[t.size() / 2]) / 2;
   }
@@ -60,9 +61,11 @@ struct Method {
 void timeInTurns(std::vector<Method>& methods, int reps) {
   for (int r = 0; r < reps; ++r)
     for (Method& m : methods) {
+      const std::clock_t c0 = std::clock();
       const auto t0 = Clock::now();
       m.run();
       const double t = std::chrono::duration<double>(Clock::now() - t0).count();
+      m.cpuTimes.push_back(double(std::clock() - c0) / CLOCKS_PER_SEC);
       m.best = std::min(m.best, t);
       m.times.push_back(t);
     }
@@ -413,6 +416,9 @@ void benchIncoherent(const std::string& path, unsigned threads, uint32_t size, i
   const vox::Grid grid = vox::voxelizeScene(scene, vox::VoxelizeOptions{});  // vox-voxelize's default grid
   const vox::Accel accel = vox::buildAccel(scene, grid, vox::AccelKind::Grid);
   const vox::Accel brute = vox::buildAccel(scene, grid, vox::AccelKind::None);
+  // The walk as before Accel::cellTriangles: triangles read by id (what a grid over the copies' budget does).
+  vox::Accel byId = vox::buildAccel(scene, grid, vox::AccelKind::Grid);
+  byId.cellTriangles.clear();
   const std::vector<RaySet> sets = secondaryRays(accel, tileRays(primary, size).rays, bounds);
   const EmbreeScene embree(scene, threads);
   const double diag = vox::length(bounds.hi - bounds.lo);
@@ -420,24 +426,37 @@ void benchIncoherent(const std::string& path, unsigned threads, uint32_t size, i
   const char* name = std::strrchr(path.c_str(), '/') ? std::strrchr(path.c_str(), '/') + 1 : path.c_str();
   std::printf("\n%s: %zu triangles, default grid %ux%ux%u, %zu secondary rays per set\n", name,
               scene.triangles.size(), grid.dims[0], grid.dims[1], grid.dims[2], sets[0].rays.size());
-  std::printf("  %-11s %10s %10s %12s %12s %8s %9s %9s %9s %s\n", "set", "query", "embree", "ours", "ours/embree",
-              "(best)", "same", "close t", "mismatch", "brute force (diff/checked)");
+  std::printf("  %-11s %10s %10s %12s %12s %8s %8s %9s %9s %9s %s\n", "set", "query", "embree", "ours", "ours/embree",
+              "(best)", "(cpu)", "same", "close t", "mismatch", "brute force (diff/checked), per ray");
   for (const RaySet& set : sets) {
     std::vector<EmbreeResult> e(set.rays.size());
     std::vector<vox::Hit> ours(set.rays.size());
     std::vector<Method> methods;
     methods.push_back({"embree", [&] { embreeTrace(embree.scene, set, e); }});
     methods.push_back({"ours", [&] { voxTrace(accel, set, ours); }});
+    std::vector<vox::Hit> byIdHits(set.rays.size());
+    methods.push_back({"ours by id", [&] { voxTrace(byId, set, byIdHits); }});
     timeInTurns(methods, reps);
+    uint64_t byIdDiff = 0;
+    for (size_t i = 0; i < ours.size(); ++i)
+      byIdDiff += ours[i].prim != byIdHits[i].prim || std::memcmp(&ours[i].t, &byIdHits[i].t, sizeof(double)) != 0;
     const Agreement a = compareWithEmbree(set, ours, e, diag);
     uint64_t checked = 0;
     const uint64_t bruteDiff = bruteForceDifferences(brute, set, ours, std::max<size_t>(1, set.rays.size() / 500), checked);
     const double n = double(set.rays.size());
-    std::printf("  %-11s %10s %8.2f M %10.2f M %12.3f %8.3f %8.3f%% %8.3f%% %9llu %llu/%llu\n", set.name.c_str(),
+    vox::TraceStats st;
+    for (size_t i = 0; i < set.rays.size(); i += 97)
+      set.occlusion ? void(vox::occluded(accel, set.rays[i], &st)) : void(vox::traceRay(accel, set.rays[i], &st));
+    std::printf("  %-11s %10s %8.2f M %10.2f M %12.3f %8.3f %8.3f %8.3f%% %8.3f%% %9llu %llu/%llu  %.1f cells, %.1f tests"
+                "  by id: %.3f (cpu %.3f), %llu differ\n",
+                set.name.c_str(),
                 set.occlusion ? "occluded" : "closest", n / methods[0].median() / 1e6, n / methods[1].median() / 1e6,
-                methods[0].median() / methods[1].median(), methods[0].best / methods[1].best, 100.0 * a.same / n,
+                methods[0].median() / methods[1].median(), methods[0].best / methods[1].best,
+                methods[0].median(true) / methods[1].median(true), 100.0 * a.same / n,
                 100.0 * a.closeT / n, (unsigned long long)a.mismatch, (unsigned long long)bruteDiff,
-                (unsigned long long)checked);
+                (unsigned long long)checked, double(st.cells) / st.rays, double(st.tests) / st.rays,
+                methods[2].median() / methods[1].median(), methods[2].median(true) / methods[1].median(true),
+                (unsigned long long)byIdDiff);
     std::fflush(stdout);
   }
 }
@@ -469,7 +488,7 @@ int main(int argc, char** argv) {
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
   if (incoherent)
     std::printf("threads: %u, secondary rays from the hits of %ux%u primary rays, Mrays/s of the median of %d rounds "
-                "taken in turns (best: ratio of best times)\n", threads, size, size, reps);
+                "taken in turns (best: ratio of best times; cpu: of median process CPU times)\n", threads, size, size, reps);
   else
     std::printf("threads: %u, image: %ux%u primary rays, best of %d rounds taken in turns\n", threads, size, size, reps);
 

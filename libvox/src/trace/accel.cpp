@@ -122,6 +122,11 @@ Accel buildAccel(const Scene& scene, const Grid& grid, AccelKind kind) {
     fail<LimitError>("grid has ", grid.occupiedCount(), " occupied cells; at most 2^32 - 2 can be traced");
   buildTables(accel, grid);
   accel.boundaries = makeCellBoundaries(grid.bounds, grid.dims);
+  if (kind == AccelKind::Grid && grid.primIds.size() <= kMaxCellTriangleBytes / sizeof(TriangleData)) {
+    accel.cellTriangles.resize(grid.primIds.size());
+    for (size_t r = 0; r < grid.primIds.size(); ++r)
+      if (grid.primIds[r] < accel.triangleCount) accel.cellTriangles[r] = accel.triangles[grid.primIds[r]];
+  }
   return accel;
 }
 

@@ -226,12 +226,19 @@ Hit traceRay(const Accel& accel, const Ray& ray, TraceStats* stats) {
       ++st.cells;
       const uint32_t c = accel.lookup(cell.idx[0], cell.idx[1], cell.idx[2]);
       if (c < kSolidCell) {
-        for (uint32_t id : accel.cellPrims(c)) {
+        const uint64_t end = accel.grid->cellStart[c + 1];
+        for (uint64_t r = accel.grid->cellStart[c]; r < end; ++r) {
+          const uint32_t id = accel.grid->primIds[r];
           if (mailbox.seen(id)) {
             ++st.mailboxSkips;
             continue;
           }
-          consider(accel, id, ray, best, st);
+          ++st.tests;
+          double t;
+          if (intersectCellPrimitive(accel, r, id, ray, t) && closer(t, id, best)) {
+            best.t = t;
+            best.prim = id;
+          }
         }
       }
       // A hit may lie beyond this cell (a primitive spanning cells): it is kept, and accepted only once the walk
@@ -266,13 +273,15 @@ bool occluded(const Accel& accel, const Ray& ray, TraceStats* stats) {
       ++st.cells;
       const uint32_t c = accel.lookup(cell.idx[0], cell.idx[1], cell.idx[2]);
       if (c >= kSolidCell) continue;
-      for (uint32_t id : accel.cellPrims(c)) {
+      const uint64_t end = accel.grid->cellStart[c + 1];
+      for (uint64_t r = accel.grid->cellStart[c]; r < end; ++r) {
+        const uint32_t id = accel.grid->primIds[r];
         if (mailbox.seen(id)) {
           ++st.mailboxSkips;
           continue;
         }
         ++st.tests;
-        if (intersectPrimitive(accel, id, ray, t)) {
+        if (intersectCellPrimitive(accel, r, id, ray, t)) {
           hit = true;
           break;
         }

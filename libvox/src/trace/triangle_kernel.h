@@ -4,6 +4,8 @@
 // -ffast-math, so every operation below rounds the same way in a scalar or a vector register.
 #pragma once
 
+#include <type_traits>
+
 namespace vox::kernel {
 
 // Four rays at once (two SSE2 or one AVX2 register).
@@ -14,7 +16,7 @@ typedef double Double4 __attribute__((vector_size(32)));
 // test compares the numerators with det (sign-aware) instead of dividing first. Branch-free (bitwise & of the
 // conditions, a select for the sign of det); a finite det is one with det - det == 0.
 // Returns whether the ray meets the triangle at a t in [tMin, tMax] (a bool for double, a lane mask for Double4);
-// `t` is written either way.
+// `t` is written either way for Double4, and for double whenever the ray meets the closed triangle.
 template <typename T>
 [[gnu::always_inline]] inline auto triangleHit(const double* v0, const double* e1, const double* e2, const double* n, T ox, T oy, T oz,
                         T dx, T dy, T dz, T tMin, T tMax, T& t) {
@@ -27,6 +29,11 @@ template <typename T>
   const auto positive = (uu >= 0) & (vv >= 0) & (sum <= det);
   const auto negative = (uu <= 0) & (vv <= 0) & (sum >= det);
   const auto inside = (det > 0) ? positive : negative;
+  if constexpr (std::is_same_v<T, double>) {
+    // One ray (intersectTriangle): most tests miss, and leaving here saves the division's latency. A ray that goes
+    // on computes the very same t as the branch-free form, so hits are unchanged.
+    if (!inside) return inside;
+  }
   t = (sx * n[0] + sy * n[1] + sz * n[2]) / det;
   return (det != 0) & (det - det == 0) & inside & (t >= tMin) & (t <= tMax);
 }

@@ -55,6 +55,11 @@ struct Accel {
   std::array<uint32_t, 3> blockDims{0, 0, 0};
   std::vector<uint32_t> blockSlot;
   std::vector<uint32_t> cellSlots;
+  // The triangles of the cells, copied in cell order: cellTriangles[r] == triangles[grid->primIds[r]] when that id is
+  // a triangle (unused otherwise). A walk then reads a cell's triangles from one run of memory instead of one random
+  // place each (a dependent cache miss per test for incoherent rays, issue 12); the same values, so the same t.
+  // Empty when it would take more than kMaxCellTriangleBytes; walks then read `triangles` by id.
+  std::vector<TriangleData> cellTriangles;
 
   uint32_t primitiveCount() const { return triangleCount + sphereCount + planeCount; }
 
@@ -79,12 +84,21 @@ struct Accel {
   std::span<const uint32_t> cellPrims(uint32_t occupiedIndex) const { return grid->cellPrims(occupiedIndex); }
 };
 
+inline constexpr uint64_t kMaxCellTriangleBytes = uint64_t(512) << 20;
+
 // The ray test of primitive `id` (any kind), as every traversal calls it.
 inline bool intersectPrimitive(const Accel& accel, uint32_t id, const Ray& ray, double& t) {
   if (id < accel.triangleCount) return intersectTriangle(accel.triangles[id], ray, t);
   const uint32_t s = id - accel.triangleCount;
   if (s < accel.sphereCount) return intersectSphere(accel.spheres[s], ray, t);
   return intersectPlane(accel.planes[s - accel.sphereCount], ray, t);
+}
+
+// The same test for the primitive at position `ref` of grid->primIds (id == grid->primIds[ref]), reading a triangle
+// from Accel::cellTriangles when there is one: the same TriangleData, so the same result and t.
+inline bool intersectCellPrimitive(const Accel& accel, uint64_t ref, uint32_t id, const Ray& ray, double& t) {
+  if (id < accel.triangleCount && !accel.cellTriangles.empty()) return intersectTriangle(accel.cellTriangles[ref], ray, t);
+  return intersectPrimitive(accel, id, ray, t);
 }
 
 // Prepares every primitive of `scene` and the cell lookup of `grid` (which must have been built from `scene`; the

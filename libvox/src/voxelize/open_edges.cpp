@@ -3,13 +3,26 @@
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <numeric>
 #include <tuple>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace vox {
 
-uint64_t countOpenEdges(std::span<const Triangle> triangles) {
+namespace {
+
+struct WeldedEdges {
+  std::vector<uint64_t> open;  // (id a << 32 | id b), a < b: used by an odd number of triangles
+  // Edges used more often in one direction than in the other (by `second`): the oriented boundary. The same as
+  // `open` for a consistently oriented mesh; also the seams where the orientation flips.
+  std::vector<std::pair<uint64_t, int>> unbalanced;
+  std::vector<uint32_t> cornerOfId;  // a corner (3 * triangle + vertex) at each welded id
+};
+
+WeldedEdges findOpenEdges(std::span<const Triangle> triangles) {
   const size_t corners = triangles.size() * 3;
   auto at = [&](uint64_t c) -> const Vec3& { return triangles[c / 3].v[c % 3]; };
   // Weld: sort corners by position; equal positions get one id. -0.0 and 0.0 compare equal, as they should.
@@ -19,32 +32,74 @@ uint64_t countOpenEdges(std::span<const Triangle> triangles) {
     const Vec3 &p = at(a), &q = at(b);
     return std::tie(p.x, p.y, p.z) < std::tie(q.x, q.y, q.z);
   });
+  WeldedEdges out;
   std::vector<uint32_t> id(corners);
-  uint32_t next = 0;
   for (size_t c = 0; c < corners; ++c) {
-    if (c > 0) {
-      const Vec3 &p = at(order[c - 1]), &q = at(order[c]);
-      if (p.x != q.x || p.y != q.y || p.z != q.z) ++next;
-    }
-    id[order[c]] = next;
+    const bool same = c > 0 && at(order[c - 1]).x == at(order[c]).x && at(order[c - 1]).y == at(order[c]).y &&
+                      at(order[c - 1]).z == at(order[c]).z;
+    if (!same) out.cornerOfId.push_back(order[c]);
+    id[order[c]] = uint32_t(out.cornerOfId.size() - 1);
   }
   order = {};
-  std::vector<uint64_t> edges;
+  // Each undirected edge with the direction it is used in: +1 from the smaller id, -1 from the larger.
+  std::vector<std::pair<uint64_t, int>> edges;
   edges.reserve(corners);
   for (size_t t = 0; t < triangles.size(); ++t)
     for (int e = 0; e < 3; ++e) {
       const uint64_t a = id[t * 3 + e], b = id[t * 3 + (e + 1) % 3];
-      if (a != b) edges.push_back(std::min(a, b) << 32 | std::max(a, b));
+      if (a != b) edges.push_back({std::min(a, b) << 32 | std::max(a, b), a < b ? 1 : -1});
     }
   tbb::parallel_sort(edges.begin(), edges.end());
-  uint64_t open = 0;
   for (size_t e = 0; e < edges.size();) {
     size_t f = e;
-    while (f < edges.size() && edges[f] == edges[e]) ++f;
-    open += (f - e) & 1;
+    int net = 0;
+    for (; f < edges.size() && edges[f].first == edges[e].first; ++f) net += edges[f].second;
+    if ((f - e) & 1) out.open.push_back(edges[e].first);
+    if (net != 0) out.unbalanced.push_back({edges[e].first, std::abs(net)});
     e = f;
   }
-  return open;
+  return out;
+}
+
+}  // namespace
+
+uint64_t countOpenEdges(std::span<const Triangle> triangles) { return findOpenEdges(triangles).open.size(); }
+
+std::vector<OpenBoundary> openBoundaries(std::span<const Triangle> triangles) {
+  const WeldedEdges w = findOpenEdges(triangles);
+  auto point = [&](uint64_t id) -> const Vec3& { return triangles[w.cornerOfId[id] / 3].v[w.cornerOfId[id] % 3]; };
+  // Union-find over the welded ids that boundary edges touch.
+  std::unordered_map<uint64_t, uint64_t> parent;
+  auto find = [&](uint64_t x) {
+    auto it = parent.try_emplace(x, x).first;
+    while (it->second != x) {
+      x = it->second;
+      it = parent.find(x);
+    }
+    return x;
+  };
+  for (const auto& [e, n] : w.unbalanced) {
+    const uint64_t a = find(e >> 32), b = find(e & 0xffffffffu);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+  std::unordered_map<uint64_t, size_t> index;
+  std::vector<OpenBoundary> out;
+  for (const auto& [e, n] : w.unbalanced) {
+    const Vec3 &p = point(e >> 32), &q = point(e & 0xffffffffu);
+    auto [it, added] = index.try_emplace(find(e >> 32), out.size());
+    if (added) out.push_back({{p, p}, 0, 0, 0});
+    OpenBoundary& b = out[it->second];
+    b.bounds.lo = minVec(minVec(b.bounds.lo, p), q);
+    b.bounds.hi = maxVec(maxVec(b.bounds.hi, p), q);
+    b.length += n * length(q - p);
+    b.edges += uint64_t(n & 1);
+  }
+  for (const auto& [e, n] : w.unbalanced) {
+    OpenBoundary& b = out[index.at(find(e >> 32))];
+    const Vec3 c = (b.bounds.lo + b.bounds.hi) * 0.5;
+    b.capArea += 0.5 * n * length(cross(point(e >> 32) - c, point(e & 0xffffffffu) - c));
+  }
+  return out;
 }
 
 }  // namespace vox

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "vox/core/scene.h"
 
@@ -14,5 +15,20 @@ namespace vox {
 // a self-intersecting or non-manifold one, has none; the rim of a hole counts each of its edges once. Edges whose
 // two ends weld together are skipped. Scratch memory: 48 bytes per triangle (the caller checks its budget).
 uint64_t countOpenEdges(std::span<const Triangle> triangles);
+
+// One connected piece of the oriented boundary (edges joined at welded vertices): the rim of one hole, usually.
+// The oriented boundary holds the edges used more often in one direction than in the other: the open edges of a
+// consistently oriented mesh, and also the seams where a mesh's orientation flips (the winding number's gradient
+// comes from these edges alone).
+struct OpenBoundary {
+  Box bounds;         // of its edges' end points, world space
+  double length = 0;  // sum of its edges' lengths, each times its direction surplus
+  // Area of the cone from the centre of `bounds` over its edges: a surface inside `bounds` that closes the hole.
+  double capArea = 0;
+  uint64_t edges = 0;  // of them open (odd use count)
+};
+// The oriented boundary of `triangles` grouped into connected pieces. For a consistently oriented mesh the sum of
+// their `edges` is countOpenEdges. Same scratch memory.
+std::vector<OpenBoundary> openBoundaries(std::span<const Triangle> triangles);
 
 }  // namespace vox

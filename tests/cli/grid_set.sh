@@ -104,6 +104,8 @@ touch "$T/blocked.bricks"
 check "brick folder blocked" 3 "$V" "$S/scene5_01_sphere.txt" -o "$T/blocked.vgrid" --grid 8 8 8 --bricks 2 2 2
 expect_err "brick folder blocked" "blocked.bricks"
 [ ! -e "$T/blocked.vgrid" ] || { echo "FAIL failed set left a manifest"; fails=$((fails + 1)); }
+check "set to a device" 3 "$V" "$S/scene5_01_sphere.txt" -o /dev/null --grid 8 8 8 --bricks 2 2 2
+expect_err "set to a device" "regular file"
 # A brick that cannot be written (a folder in its place): exit 3, no manifest.
 mkdir -p "$T/stuck.bricks/b_0_0_0.vgrid"
 check "brick write fails" 3 "$V" "$S/scene5_01_sphere.txt" -o "$T/stuck.vgrid" --grid 8 8 8 --bricks 2 2 2

@@ -32,6 +32,9 @@ std::string brickFileName(const std::string& setPath, const std::array<uint32_t,
 void makeBrickFolder(const std::string& setPath) {
   const auto folder = std::filesystem::path(setPath).parent_path() / brickFolderName(setPath);
   std::error_code ec;
+  // A device or FIFO can take a grid's bytes but not a set: its bricks would go into /dev.
+  if (std::filesystem::exists(setPath, ec) && !std::filesystem::is_regular_file(setPath, ec))
+    fail<OutputError>(setPath, ": cannot write: a grid set's manifest must be a regular file");
   std::filesystem::create_directory(folder, ec);
   if (ec || !std::filesystem::is_directory(folder, ec))
     fail<OutputError>(folder.string(), ": cannot create the brick folder",

@@ -427,6 +427,33 @@ TEST(Vdb, LongSolidRunsBecomeTiles) {
   EXPECT_EQ(s.leafNodes, 32u);  // only the 32 leaves holding the missing column (0, 0, k) stay leaves
 }
 
+// Boxes, rectangles and layers of changing shape: the density builder merges rows into boxes; the voxels must stay
+// exactly the grid's.
+TEST(Vdb, MergedBoxesKeepTheExactVoxels) {
+  Grid g;
+  g.dims = {40, 30, 50};
+  g.bounds = {{0, 0, 0}, {4, 3, 5}};
+  for (uint32_t k = 0; k < 50; ++k)
+    for (uint32_t j = 0; j < 30; ++j) {
+      const bool box = k >= 2 && k < 31 && j >= 3 && j < 27;  // a 29-layer box of x 5..34
+      const uint32_t w = 1 + (j * 7 + k * 3) % 11;            // and rows that change every layer
+      const uint32_t i0 = box ? 5 : (k % 4 == 1 ? 0 : 2), n = box ? 30 : w;
+      if (k % 9 == 8 && !box) continue;                      // empty layers
+      g.solidRuns.push_back({cellKey(g.dims, i0, j, k), n});
+    }
+  std::ostringstream out;
+  const VdbStats s = writeVdb(out, g);
+  std::istringstream in(out.str());
+  openvdb::initialize();
+  openvdb::io::Stream stream(in);
+  auto density = openvdb::gridPtrCast<openvdb::FloatGrid>(openvdb::findGridByName(*stream.getGrids(), "density"));
+  ASSERT_TRUE(density);
+  const std::set<Cell> cells = voxelSet(g);
+  EXPECT_EQ(s.activeVoxels, cells.size());
+  EXPECT_EQ(density->activeVoxelCount(), cells.size());
+  for (const Cell& c : cells) ASSERT_TRUE(density->tree().isValueOn(openvdb::Coord{int(c[0]), int(c[1]), int(c[2])}));
+}
+
 TEST(VoxelFormat, ExtensionsAndFilesThroughTheOutputFile) {
   EXPECT_EQ(voxelFormatFromPath("a/b.BINVOX"), VoxelFormat::Binvox);
   EXPECT_EQ(voxelFormatFromPath("b.vox"), VoxelFormat::MagicaVoxel);

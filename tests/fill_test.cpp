@@ -32,8 +32,11 @@ TEST(Fill, ClosedBoxInteriorIsSolid) {
   opt.dims = {10, 10, 10};
   Grid grid = voxelizeScene(scene, opt);
   fillSolid(grid, 1 << 20);
-  EXPECT_EQ(grid.solidKeys.size(), 6u * 6 * 6);
-  for (uint64_t key : grid.solidKeys) {
+  EXPECT_EQ(grid.solidCount(), 6u * 6 * 6);
+  std::vector<uint64_t> solidKeys;
+  for (const CellRun& r : grid.solidRuns)
+    for (uint64_t key = r.first; key < r.first + r.count; ++key) solidKeys.push_back(key);
+  for (uint64_t key : solidKeys) {
     const auto ijk = cellIndex(grid.dims, key);
     for (int a = 0; a < 3; ++a) {
       EXPECT_GE(ijk[a], 2u);
@@ -51,7 +54,7 @@ TEST(Fill, OpenSurfaceEnclosesNothingAndSphereIsFilled) {
   opt.dims = {10, 10, 10};
   Grid open = voxelizeScene(scene, opt);
   fillSolid(open, 1 << 20);
-  EXPECT_TRUE(open.solidKeys.empty());
+  EXPECT_TRUE(open.solidRuns.empty());
 
   Scene ball;
   ball.materials.push_back({});
@@ -70,7 +73,7 @@ TEST(Fill, OpenSurfaceEnclosesNothingAndSphereIsFilled) {
         const bool occupied = findCell(g, key) >= 0;
         double far = 0;
         for (int a = 0; a < 3; ++a) far += std::max(b.lo[a] * b.lo[a], b.hi[a] * b.hi[a]);
-        const bool solid = std::binary_search(g.solidKeys.begin(), g.solidKeys.end(), key);
+        const bool solid = isSolid(g, key);
         if (!occupied && far < 1) ++inside;
         EXPECT_EQ(solid, !occupied && far < 1) << i << " " << j << " " << k;
       }

@@ -1,6 +1,7 @@
 // Grid files: exact round trip; truncation at every byte and every single-bit flip refused with InputError.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <random>
@@ -147,6 +148,101 @@ TEST(GridFile, ParserChecksStructureEvenWithAValidChecksum) {
   Scene badMaterial = scene;
   badMaterial.triangles[0].material = 9;
   EXPECT_THROW(decodeGridFile(encodeGridFile(badMaterial, grid), "x"), InputError);
+}
+
+// Rebuilds `v2` (a version 2 encoding whose grid has no solid runs and no sections) as the version 1 file that
+// stored `solidKeys` one key each: the same payload up to the solid cells, then array<u64> of keys.
+std::string asVersion1(const std::string& v2, const std::vector<uint64_t>& solidKeys) {
+  std::string bytes = v2.substr(0, v2.size() - 8);  // drop the empty run array's count
+  const uint64_t n = solidKeys.size();
+  bytes.append(reinterpret_cast<const char*>(&n), 8);
+  bytes.append(reinterpret_cast<const char*>(solidKeys.data()), n * 8);
+  const uint32_t version = 1;
+  const uint64_t size = bytes.size() - 32, sum = gridChecksum(bytes.data() + 32, size);
+  std::memcpy(bytes.data() + 8, &version, 4);
+  std::memcpy(bytes.data() + 16, &size, 8);
+  std::memcpy(bytes.data() + 24, &sum, 8);
+  return bytes;
+}
+
+// Replaces the checksum of an edited encoding, so the parser's own checks face the edit.
+std::string resum(std::string bytes) {
+  const uint64_t size = bytes.size() - 32, sum = gridChecksum(bytes.data() + 32, size);
+  std::memcpy(bytes.data() + 16, &size, 8);
+  std::memcpy(bytes.data() + 24, &sum, 8);
+  return bytes;
+}
+
+TEST(GridFile, SolidRunsRoundTripAndVersion1KeysStillRead) {
+  const Scene scene = sampleScene();
+  VoxelizeOptions opt;
+  opt.dims = {7, 5, 3};
+  Grid grid = voxelizeScene(scene, opt);
+  const std::string plain = encodeGridFile(scene, grid);
+  // Keys 3,4,5 and 9 and the last cell: runs {3,3}, {9,1}, {104,1}; one run crossing a row boundary (6, 7).
+  const std::vector<uint64_t> keys = {3, 4, 5, 6, 7, 9, 104};
+  for (uint64_t k : keys) appendSolidKey(grid.solidRuns, k);
+  ASSERT_EQ(grid.solidRuns.size(), 3u);
+  EXPECT_EQ(grid.solidRuns[0].first, 3u);
+  EXPECT_EQ(grid.solidRuns[0].count, 5u);
+  EXPECT_EQ(grid.solidCount(), 7u);
+  for (uint64_t k = 0; k < grid.cellCount(); ++k)
+    EXPECT_EQ(isSolid(grid, k), std::find(keys.begin(), keys.end(), k) != keys.end()) << k;
+  const GridFile back = decodeGridFile(encodeGridFile(scene, grid), "runs.vgrid");
+  ASSERT_EQ(back.grid.solidRuns.size(), grid.solidRuns.size());
+  for (size_t r = 0; r < grid.solidRuns.size(); ++r) {
+    EXPECT_EQ(back.grid.solidRuns[r].first, grid.solidRuns[r].first);
+    EXPECT_EQ(back.grid.solidRuns[r].count, grid.solidRuns[r].count);
+  }
+  // The same grid written by version 1 (one key per solid cell) reads as the same runs.
+  const GridFile old = decodeGridFile(asVersion1(plain, keys), "old.vgrid");
+  ASSERT_EQ(old.grid.solidRuns.size(), 3u);
+  EXPECT_EQ(old.grid.solidCount(), 7u);
+  EXPECT_EQ(old.grid.cellKeys, grid.cellKeys);
+  EXPECT_EQ(encodeGridFile(old.scene, old.grid), encodeGridFile(scene, grid));
+  EXPECT_THROW(decodeGridFile(asVersion1(plain, {5, 4}), "old.vgrid"), InputError);
+  EXPECT_THROW(decodeGridFile(asVersion1(plain, {105}), "old.vgrid"), InputError);
+}
+
+TEST(GridFile, BadSolidRunsAndUnknownSectionsAreRefused) {
+  const Scene scene = sampleScene();
+  VoxelizeOptions opt;
+  opt.dims = {4, 4, 4};
+  const Grid grid = voxelizeScene(scene, opt);
+  const std::vector<std::vector<CellRun>> bad = {
+      {{0, 0}},             // empty run
+      {{60, 5}},            // past the last cell
+      {{10, 2}, {12, 1}},   // adjacent: must have been one run
+      {{10, 3}, {11, 1}},   // overlapping
+      {{20, 1}, {10, 1}},   // unsorted
+      {{UINT64_MAX, 2}},    // wraps around
+  };
+  for (const auto& runs : bad) {
+    Grid g = grid;
+    g.solidRuns = runs;
+    try {
+      decodeGridFile(encodeGridFile(scene, g), "runs.vgrid");
+      FAIL() << "bad runs accepted: first " << runs[0].first;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("runs.vgrid: solid runs at byte"), std::string::npos) << e.what();
+    }
+  }
+  // A section this build does not know (a newer writer's) is refused by name, not skipped or misread.
+  std::string bytes = encodeGridFile(scene, grid);
+  const uint32_t tag = 999;
+  const uint64_t size = 4;
+  bytes.append(reinterpret_cast<const char*>(&tag), 4);
+  bytes.append(reinterpret_cast<const char*>(&size), 8);
+  bytes.append("abcd");
+  try {
+    decodeGridFile(resum(bytes), "tag.vgrid");
+    FAIL() << "unknown section accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown section tag 999"), std::string::npos) << e.what();
+  }
+  // A section header promising more bytes than remain.
+  bytes.resize(bytes.size() - 2);
+  EXPECT_THROW(decodeGridFile(resum(bytes), "tag.vgrid"), InputError);
 }
 
 TEST(GridFile, NewerVersionAndMissingFile) {

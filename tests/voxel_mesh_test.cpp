@@ -37,8 +37,10 @@ Grid makeGrid(const std::array<uint32_t, 3>& dims, const CellSet& cells, const C
     for (uint32_t p = 0; p <= i % 3; ++p) g.primIds.push_back(p);
     g.cellStart.push_back(g.primIds.size());
   }
-  for (const Cell& c : solid) g.solidKeys.push_back(cellKey(dims, c[0], c[1], c[2]));
-  std::sort(g.solidKeys.begin(), g.solidKeys.end());
+  std::vector<uint64_t> solidKeys;
+  for (const Cell& c : solid) solidKeys.push_back(cellKey(dims, c[0], c[1], c[2]));
+  std::sort(solidKeys.begin(), solidKeys.end());
+  for (uint64_t key : solidKeys) appendSolidKey(g.solidRuns, key);
   return g;
 }
 

@@ -118,12 +118,12 @@ int run(const Options& opt) {
     const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::fprintf(stderr,
                  "triangles: %zu\nspheres: %zu\nplanes: %zu\ndegenerate_triangles: %llu\ndims: %u %u %u\nmethod: %s\n"
-                 "cells_tested: %llu\nexact_fallbacks: %llu\noccupied_cells: %zu\nsolid_cells: %zu\nreferences: %zu\n"
+                 "cells_tested: %llu\nexact_fallbacks: %llu\noccupied_cells: %zu\nsolid_cells: %llu\nreferences: %zu\n"
                  "voxelize_seconds: %.6f\ntotal_seconds: %.6f\npeak_memory_mb: %.1f\n",
                  scene.triangles.size(), scene.spheres.size(), scene.planes.size(),
                  (unsigned long long)stats.degenerateTriangles, grid.dims[0], grid.dims[1], grid.dims[2],
                  methodName(grid.method).c_str(), (unsigned long long)stats.cellsTested,
-                 (unsigned long long)stats.exactFallbacks, grid.occupiedCount(), grid.solidKeys.size(), grid.referenceCount(), stats.seconds,
+                 (unsigned long long)stats.exactFallbacks, grid.occupiedCount(), (unsigned long long)grid.solidCount(), grid.referenceCount(), stats.seconds,
                  total, double(usage.ru_maxrss) / 1024.0);
   }
   return kExitOk;

@@ -39,6 +39,34 @@ int64_t findCell(const Grid& grid, uint64_t key) {
   return it - grid.cellKeys.begin();
 }
 
+bool isSolid(const Grid& grid, uint64_t key) {
+  // The first run starting after `key`; the run before it is the only one that can hold it.
+  const auto it = std::upper_bound(grid.solidRuns.begin(), grid.solidRuns.end(), key,
+                                   [](uint64_t k, const CellRun& r) { return k < r.first; });
+  if (it == grid.solidRuns.begin()) return false;
+  const CellRun& r = *(it - 1);
+  return key - r.first < r.count;
+}
+
+void appendSolidKey(std::vector<CellRun>& runs, uint64_t key) {
+  if (!runs.empty() && runs.back().first + runs.back().count == key)
+    ++runs.back().count;
+  else
+    runs.push_back({key, 1});
+}
+
+void checkSolidRuns(const std::vector<CellRun>& runs, uint64_t cellCount, const std::string& what) {
+  uint64_t end = 0;  // one past the previous run
+  for (size_t r = 0; r < runs.size(); ++r) {
+    const CellRun& run = runs[r];
+    if (run.count == 0) fail<InputError>(what, ": solid run ", r, " is empty");
+    if (run.first >= cellCount || run.count > cellCount - run.first)
+      fail<InputError>(what, ": solid run ", r, " reaches outside the grid");
+    if (r > 0 && run.first <= end) fail<InputError>(what, ": solid run ", r, " not sorted, overlapping or adjacent");
+    end = run.first + run.count;
+  }
+}
+
 std::array<int64_t, 2> cellRange(const Box& bounds, const std::array<uint32_t, 3>& dims, int axis, double lo,
                                  double hi) {
   const double scale = double(dims[axis]) / (bounds.hi[axis] - bounds.lo[axis]);

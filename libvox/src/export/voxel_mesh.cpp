@@ -35,6 +35,7 @@
 #include "vox/export/cell_color.h"
 #include "vox/export/colormap.h"
 #include "vox/core/error.h"
+#include "vox/io/input_file.h"
 
 namespace vox {
 
@@ -131,25 +132,32 @@ Voxels gatherVoxels(const Grid& grid, const Scene& scene, ColorMode mode) {
     }
   };
   checkSorted(grid.cellKeys, "cell");
-  checkSorted(grid.solidKeys, "solid cell");
+  checkSolidRuns(grid.solidRuns, cellCount, "grid");
+  const uint64_t solidCount = grid.solidCount();
+  checkMemory((nOcc + solidCount) * 12, "grid", "the voxel list");
 
   const std::vector<uint32_t> occColor = occupiedColors(grid, scene, mode);
 
-  // Merge occupied and solid keys; a cell in both lists is drawn once, with its occupied colour.
+  // Merge occupied keys and solid runs; a cell in both is drawn once, with its occupied colour.
   const uint32_t solid = mode == ColorMode::None ? kNoColor : packColor(kSolidCellColor);
   Voxels v;
-  v.keys.reserve(nOcc + grid.solidKeys.size());
-  v.colors.reserve(nOcc + grid.solidKeys.size());
-  size_t a = 0, b = 0;
-  while (a < nOcc || b < grid.solidKeys.size()) {
-    if (b == grid.solidKeys.size() || (a < nOcc && grid.cellKeys[a] <= grid.solidKeys[b])) {
-      if (b < grid.solidKeys.size() && grid.solidKeys[b] == grid.cellKeys[a]) ++b;
-      v.keys.push_back(grid.cellKeys[a]);
-      v.colors.push_back(occColor[a++]);
-    } else {
-      v.keys.push_back(grid.solidKeys[b++]);
+  v.keys.reserve(nOcc + solidCount);
+  v.colors.reserve(nOcc + solidCount);
+  size_t a = 0;
+  for (const CellRun& run : grid.solidRuns) {
+    for (uint64_t key = run.first; key < run.first + run.count; ++key) {
+      for (; a < nOcc && grid.cellKeys[a] < key; ++a) {
+        v.keys.push_back(grid.cellKeys[a]);
+        v.colors.push_back(occColor[a]);
+      }
+      if (a < nOcc && grid.cellKeys[a] == key) continue;  // occupied wins; pushed by the loop above next time
+      v.keys.push_back(key);
       v.colors.push_back(solid);
     }
+  }
+  for (; a < nOcc; ++a) {
+    v.keys.push_back(grid.cellKeys[a]);
+    v.colors.push_back(occColor[a]);
   }
   return v;
 }

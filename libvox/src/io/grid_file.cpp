@@ -9,6 +9,8 @@
 #include "vox/io/atomic_file.h"
 #include "vox/core/error.h"
 #include "vox/io/input_file.h"
+#include "io/byte_codec.h"
+#include "io/grid_sections.h"
 
 static_assert(std::endian::native == std::endian::little, "grid files are little-endian; big-endian hosts need byte swaps");
 
@@ -36,95 +38,6 @@ uint64_t wordChecksum(const char* data, size_t size) {
   return h ^ (h >> 32);
 }
 
-class ByteWriter {
- public:
-  template <typename T>
-  void put(const T& value) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    const char* p = reinterpret_cast<const char*>(&value);
-    out_.append(p, sizeof(T));
-  }
-  void putVec(const Vec3& v) {
-    put(v.x);
-    put(v.y);
-    put(v.z);
-  }
-  void putString(const std::string& s) {
-    put(uint32_t(s.size()));
-    out_.append(s);
-  }
-  template <typename T>
-  void putArray(const std::vector<T>& values) {
-    put(uint64_t(values.size()));
-    out_.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
-  }
-  std::string& bytes() { return out_; }
-
- private:
-  std::string out_;
-};
-
-class ByteReader {
- public:
-  ByteReader(const std::string& bytes, size_t offset, const std::string& name)
-      : data_(bytes), pos_(offset), name_(name) {}
-
-  [[noreturn]] void corrupt(const std::string& what) const { fail<InputError>(name_, ": byte ", pos_, ": ", what); }
-
-  void need(uint64_t n) const {
-    if (n > data_.size() - pos_) fail<InputError>(name_, ": truncated at byte ", data_.size(), " (needed ", n, " more bytes at byte ", pos_, ")");
-  }
-  template <typename T>
-  T get() {
-    need(sizeof(T));
-    T value;
-    std::memcpy(&value, data_.data() + pos_, sizeof(T));
-    pos_ += sizeof(T);
-    return value;
-  }
-  double getFinite(const char* what) {
-    const double v = get<double>();
-    if (!std::isfinite(v)) corrupt(std::string(what) + " is not a finite number");
-    return v;
-  }
-  Vec3 getVec(const char* what) {
-    Vec3 v;
-    v.x = getFinite(what);
-    v.y = getFinite(what);
-    v.z = getFinite(what);
-    return v;
-  }
-  std::string getString() {
-    const uint32_t n = get<uint32_t>();
-    need(n);
-    std::string s = data_.substr(pos_, n);
-    pos_ += n;
-    return s;
-  }
-  // A count of elements of `elementSize` bytes each that must fit in the rest of the file: refuses absurd counts
-  // before anything is allocated.
-  uint64_t getCount(size_t elementSize, const char* what) {
-    const uint64_t n = get<uint64_t>();
-    if (n > (data_.size() - pos_) / elementSize) corrupt(std::string(what) + " count " + std::to_string(n) + " exceeds the file");
-    return n;
-  }
-  template <typename T>
-  std::vector<T> getArray(const char* what) {
-    const uint64_t n = getCount(sizeof(T), what);
-    std::vector<T> values(n);
-    if (n > 0) std::memcpy(values.data(), data_.data() + pos_, n * sizeof(T));  // data() may be null when empty
-    pos_ += n * sizeof(T);
-    return values;
-  }
-  size_t position() const { return pos_; }
-  bool atEnd() const { return pos_ == data_.size(); }
-
- private:
-  const std::string& data_;
-  size_t pos_;
-  const std::string& name_;
-};
-
 void putMaterial(ByteWriter& w, const Material& m) {
   w.putString(m.name);
   w.putVec(m.diffuse);
@@ -145,6 +58,56 @@ Material getMaterial(ByteReader& r) {
   m.transparent = r.getVec("material colour");
   m.indexOfRefraction = r.getFinite("material index of refraction");
   return m;
+}
+
+// Every optional section this build reads and writes, in the order they are written. Add new sections here.
+const std::vector<SectionCodec>& sectionCodecs() {
+  static const std::vector<SectionCodec> codecs = {
+  };
+  return codecs;
+}
+
+void putSections(ByteWriter& w, const Scene& scene, const Grid& grid) {
+  for (const SectionCodec& codec : sectionCodecs()) {
+    if (!codec.has(scene, grid)) continue;
+    w.put(uint32_t(codec.tag));
+    const size_t sizeAt = w.bytes().size();
+    w.put(uint64_t(0));  // patched below, once the body's length is known
+    codec.put(w, scene, grid);
+    const uint64_t size = w.bytes().size() - sizeAt - 8;
+    std::memcpy(w.bytes().data() + sizeAt, &size, 8);
+  }
+}
+
+void getSections(ByteReader& r, Scene& scene, Grid& grid) {
+  std::vector<bool> seen(sectionCodecs().size(), false);
+  while (!r.atEnd()) {
+    const uint32_t tag = r.get<uint32_t>();
+    const uint64_t size = r.get<uint64_t>();
+    r.need(size);
+    size_t c = 0;
+    while (c < sectionCodecs().size() && uint32_t(sectionCodecs()[c].tag) != tag) ++c;
+    if (c == sectionCodecs().size()) r.corrupt("unknown section tag " + std::to_string(tag) + " (written by a newer libvox?)");
+    const SectionCodec& codec = sectionCodecs()[c];
+    if (seen[c]) r.corrupt(std::string("repeated ") + codec.name + " section");
+    seen[c] = true;
+    const size_t start = r.position();
+    codec.get(r, scene, grid);
+    if (r.position() - start != size) r.corrupt(std::string(codec.name) + " section does not match its size");
+  }
+}
+
+// Version 1 stored one key per solid cell; runs are what the rest of libvox uses.
+std::vector<CellRun> getSolidKeysAsRuns(ByteReader& r, uint64_t cells) {
+  const size_t at = r.position();
+  const std::vector<uint64_t> keys = r.getArray<uint64_t>("solid cell");
+  std::vector<CellRun> runs;
+  for (size_t c = 0; c < keys.size(); ++c) {
+    if (keys[c] >= cells || (c > 0 && keys[c] <= keys[c - 1]))
+      fail<InputError>(r.name(), ": cell table at byte ", at, ": solid cells not sorted");
+    appendSolidKey(runs, keys[c]);
+  }
+  return runs;
 }
 
 }  // namespace
@@ -208,7 +171,8 @@ std::string encodeGridFile(const Scene& scene, const Grid& grid) {
   w.putArray(grid.cellStart);
   w.putArray(grid.primIds);
   w.putArray(grid.outsidePrims);
-  w.putArray(grid.solidKeys);
+  w.putArray(grid.solidRuns);
+  putSections(w, scene, grid);
 
   std::string bytes = std::move(w.bytes());
   const uint64_t payloadSize = bytes.size() - kHeaderSize;
@@ -322,12 +286,19 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
   grid.cellStart = r.getArray<uint64_t>("cell start");
   grid.primIds = r.getArray<uint32_t>("reference");
   grid.outsidePrims = r.getArray<uint32_t>("outside primitive");
-  grid.solidKeys = r.getArray<uint64_t>("solid cell");
-  if (!r.atEnd()) r.corrupt("unexpected bytes after the solid cells");
+  const uint64_t cells = grid.cellCount();
+  if (version == 1) {
+    grid.solidRuns = getSolidKeysAsRuns(r, cells);
+    if (!r.atEnd()) r.corrupt("unexpected bytes after the solid cells");
+  } else {
+    const size_t runsAt = r.position();
+    grid.solidRuns = r.getArray<CellRun>("solid run");
+    checkSolidRuns(grid.solidRuns, cells, name + ": solid runs at byte " + std::to_string(runsAt));
+    getSections(r, scene, grid);
+  }
 
   // Structural checks: sorted unique keys inside the grid, offsets that partition the references, ids in range.
   auto bad = [&](const std::string& what) { fail<InputError>(name, ": cell table at byte ", cellsAt, ": ", what); };
-  const uint64_t cells = grid.cellCount();
   const uint64_t bounded = nTri + nSph;
   for (size_t c = 0; c < grid.cellKeys.size(); ++c)
     if (grid.cellKeys[c] >= cells || (c > 0 && grid.cellKeys[c] <= grid.cellKeys[c - 1]))
@@ -346,8 +317,6 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
   }
   for (uint32_t id : grid.outsidePrims)
     if (id >= bounded) bad("outside primitive id out of range");
-  for (size_t c = 0; c < grid.solidKeys.size(); ++c)
-    if (grid.solidKeys[c] >= cells || (c > 0 && grid.solidKeys[c] <= grid.solidKeys[c - 1])) bad("solid cells not sorted");
   // The same checks as at import (singular ellipsoid transforms, cameras that cannot form an image, materials),
   // so a grid file that passes here traces and exports.
   validateScene(scene, name);

@@ -51,7 +51,7 @@ Summary summarize(const GridFile& file) {
   for (const auto& sp : file.scene.spheres) s.ellipsoids += sp.isEllipsoid();
   const Grid& g = file.grid;
   s.memoryBytes = g.cellKeys.size() * 8 + g.cellStart.size() * 8 + g.primIds.size() * 4 + g.outsidePrims.size() * 4 +
-                  g.solidKeys.size() * 8;
+                  g.solidRuns.size() * 16;
   for (size_t c = 0; c < g.occupiedCount(); ++c) ++s.histogram[g.cellStart[c + 1] - g.cellStart[c]];
   return s;
 }
@@ -71,7 +71,7 @@ std::string plain(const GridFile& file) {
   out << "lights: " << sc.lights.size() << "\n";
   out << "camera: " << (sc.camera ? (sc.camera->kind == CameraKind::Perspective ? "perspective" : "orthographic") : "none") << "\n";
   out << "occupied_cells: " << g.occupiedCount() << "\n";
-  out << "solid_cells: " << g.solidKeys.size() << "\n";
+  out << "solid_cells: " << g.solidCount() << "\n";
   out << "references: " << g.referenceCount() << "\n";
   out << "outside_primitives: " << g.outsidePrims.size() << "\n";
   out << "memory_bytes: " << s.memoryBytes << "\n";
@@ -99,7 +99,7 @@ std::string json(const GridFile& file, const InfoOptions& options) {
       << ", \"plane\": " << sc.planes.size() << ", \"degenerate_triangle\": " << s.degenerate
       << ", \"ellipsoid\": " << s.ellipsoids << "},\n";
   out << "  \"occupied_cells\": " << g.occupiedCount() << ",\n";
-  out << "  \"solid_cells\": " << g.solidKeys.size() << ",\n";
+  out << "  \"solid_cells\": " << g.solidCount() << ",\n";
   out << "  \"references\": " << g.referenceCount() << ",\n";
   out << "  \"outside_primitives\": " << g.outsidePrims.size() << ",\n";
   out << "  \"memory_bytes\": " << s.memoryBytes << ",\n";

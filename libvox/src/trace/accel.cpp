@@ -18,7 +18,7 @@ uint32_t Accel::lookupSlow(uint32_t i, uint32_t j, uint32_t k) const {
   const uint64_t key = cellKey(grid->dims, i, j, k);
   const int64_t c = findCell(*grid, key);
   if (c >= 0) return uint32_t(c);
-  if (std::binary_search(grid->solidKeys.begin(), grid->solidKeys.end(), key)) return kSolidCell;
+  if (isSolid(*grid, key)) return kSolidCell;
   return kEmptyCell;
 }
 
@@ -66,22 +66,32 @@ void buildTables(Accel& accel, const Grid& grid) {
   std::vector<uint32_t> slot(blockCount, kEmptyCell);
   uint32_t used = 0;
   const uint64_t perBlock = uint64_t(1) << (3 * shift);
-  for (const auto* keys : {&grid.cellKeys, &grid.solidKeys}) {
-    for (uint64_t key : *keys) {
-      const uint64_t b = blockOf(cellIndex(dims, key));
-      if (slot[b] == kEmptyCell) {
-        if ((uint64_t(used) + 1) * perBlock * 4 > kMaxTableBytes) return;
-        slot[b] = used++;
-      }
+  const auto claim = [&](uint64_t key) {
+    const uint64_t b = blockOf(cellIndex(dims, key));
+    if (slot[b] == kEmptyCell) {
+      if ((uint64_t(used) + 1) * perBlock * 4 > kMaxTableBytes) return false;
+      slot[b] = used++;
     }
-  }
+    return true;
+  };
+  for (uint64_t key : grid.cellKeys)
+    if (!claim(key)) return;
+  // A solid run visits each block it crosses once per row, not once per cell.
+  for (const CellRun& run : grid.solidRuns)
+    for (uint64_t key = run.first; key < run.first + run.count;) {
+      if (!claim(key)) return;
+      const uint64_t i = key % dims[0];
+      const uint64_t blockEnd = std::min<uint64_t>(((i >> shift) + 1) << shift, dims[0]);
+      key += std::min<uint64_t>(run.first + run.count - key, blockEnd - i);
+    }
   accel.cellSlots.assign(uint64_t(used) * perBlock, kEmptyCell);
   const uint32_t m = (1u << shift) - 1;
   const auto entry = [&](const std::array<uint32_t, 3>& c) -> uint32_t& {
     return accel.cellSlots[(uint64_t(slot[blockOf(c)]) << (3 * shift)) +
                            ((c[0] & m) | ((c[1] & m) << shift) | ((c[2] & m) << (2 * shift)))];
   };
-  for (uint64_t key : grid.solidKeys) entry(cellIndex(dims, key)) = kSolidCell;
+  for (const CellRun& run : grid.solidRuns)
+    for (uint64_t key = run.first; key < run.first + run.count; ++key) entry(cellIndex(dims, key)) = kSolidCell;
   for (size_t c = 0; c < grid.cellKeys.size(); ++c) entry(cellIndex(dims, grid.cellKeys[c])) = uint32_t(c);
   accel.blockShift = shift;
   accel.blockDims = bd;

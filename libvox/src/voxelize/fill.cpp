@@ -81,22 +81,14 @@ void fillSolid(Grid& grid, uint64_t memoryLimitBytes) {
       }
       flood();
     }
-  // Counted before the keys are allocated: a key costs 8 bytes here and 8 more in the encoded grid file.
-  uint64_t solid = 0;
-  for (uint64_t w = 0; w < blocked.wordCount(); ++w) solid += uint64_t(std::popcount(~blocked.word(w)));
-  solid -= blocked.wordCount() * 64 - cells;  // padding bits past the last cell are free but not cells
-  const double needed = double(cells) / 8 + 16.0 * double(solid);
-  if (needed > double(memoryLimitBytes))
-    fail<LimitError>("solid fill of a ", d[0], "x", d[1], "x", d[2], " grid: ", solid, " solid cells need about ",
-                     uint64_t(needed / (1 << 20)), " MiB, more than the ", memoryLimitBytes >> 20, " MiB allowed");
-  grid.solidKeys.clear();
-  grid.solidKeys.reserve(solid);
+  // Runs are appended as the free bits are met in key order; a run costs 16 bytes, at most one per two cells.
+  grid.solidRuns.clear();
   for (uint64_t w = 0; w < blocked.wordCount(); ++w) {
     uint64_t free = ~blocked.word(w);
     while (free) {
       const uint64_t key = w * 64 + uint64_t(std::countr_zero(free));
       if (key >= cells) break;
-      grid.solidKeys.push_back(key);
+      appendSolidKey(grid.solidRuns, key);
       free &= free - 1;
     }
   }

@@ -12,6 +12,13 @@
 
 namespace vox {
 
+// A run of consecutive cell keys first .. first + count - 1 (count >= 1). Solid interiors are long runs along x,
+// so a filled 2048^3 grid costs megabytes, not the 8 GiB of one key per cell.
+struct CellRun {
+  uint64_t first = 0;
+  uint64_t count = 0;
+};
+
 enum class OverlapMethod : uint8_t { Center = 0, BBox = 1, Sat = 2, Exact = 3 };
 
 std::string methodName(OverlapMethod method);
@@ -29,12 +36,18 @@ struct Grid {
   std::vector<uint32_t> primIds;
   // Bounded primitives that stick out of user-given bounds: tracing tests them for every ray, like planes.
   std::vector<uint32_t> outsidePrims;
-  // Cells inside closed surfaces (--fill), sorted keys; they hold no primitive.
-  std::vector<uint64_t> solidKeys;
+  // Cells inside the surface (--fill): sorted, disjoint, non-adjacent runs of keys. They hold no primitive; a cell
+  // may be both occupied and solid (tracing and export treat it as occupied).
+  std::vector<CellRun> solidRuns;
 
   uint64_t cellCount() const { return uint64_t(dims[0]) * dims[1] * dims[2]; }
   size_t occupiedCount() const { return cellKeys.size(); }
   size_t referenceCount() const { return primIds.size(); }
+  uint64_t solidCount() const {
+    uint64_t n = 0;
+    for (const CellRun& r : solidRuns) n += r.count;
+    return n;
+  }
   std::span<const uint32_t> cellPrims(size_t occupiedIndex) const {
     return {primIds.data() + cellStart[occupiedIndex], primIds.data() + cellStart[occupiedIndex + 1]};
   }
@@ -57,6 +70,13 @@ Box cellBox(const Grid& grid, uint32_t i, uint32_t j, uint32_t k);
 
 // Index of the occupied cell with `key`, or -1. O(log occupied).
 int64_t findCell(const Grid& grid, uint64_t key);
+// Whether `key` lies in one of grid.solidRuns. O(log runs).
+bool isSolid(const Grid& grid, uint64_t key);
+// Appends `key` to sorted runs, extending the last run when adjacent. Keys must come in increasing order.
+void appendSolidKey(std::vector<CellRun>& runs, uint64_t key);
+// Throws InputError (prefixed by `what`) unless the runs are sorted, disjoint, non-adjacent, non-empty and inside
+// a grid of `cellCount` cells.
+void checkSolidRuns(const std::vector<CellRun>& runs, uint64_t cellCount, const std::string& what);
 
 // Smallest index range [first, last] of cells on `axis` whose closed boxes meet [lo, hi] (clamped to the grid);
 // uses cellBoundary, so a coordinate exactly on a boundary yields both neighbouring cells. first > last when the

@@ -64,7 +64,7 @@ struct VoxelMeshStats {
   double seconds = 0;       // time in buildVoxelMesh
 };
 
-// Builds the voxel mesh of `grid`. A voxel is a cell listed in grid.cellKeys (occupied) or grid.solidKeys (solid).
+// Builds the voxel mesh of `grid`. A voxel is a cell listed in grid.cellKeys (occupied) or grid.solidRuns (solid).
 // `scene` supplies the materials for ColorMode::Material (primitive ids as in scene.h); it is not read otherwise.
 //  - All: 8 vertices and 12 triangles per voxel, in the order of the voxels' keys.
 //  - Exposed: one quad per exposed unit square. Where voxels meet only along an edge or at a corner, lattice points

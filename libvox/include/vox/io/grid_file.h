@@ -9,7 +9,8 @@
 
 namespace vox {
 
-inline constexpr uint32_t kGridFileVersion = 1;
+// Version 2: solid cells as runs, optional tagged sections. Version 1 files still read.
+inline constexpr uint32_t kGridFileVersion = 2;
 
 struct GridFile {
   Scene scene;

@@ -1,0 +1,29 @@
+// Optional parts of a grid file (docs/grid-format.md "Sections"), each a tagged section after the solid runs:
+// u32 tag, u64 size, then `size` bytes of body. A section is written only when it has content; a reader refuses
+// unknown and repeated tags, and a body that its decoder does not consume exactly.
+//
+// To add a section: give it a tag here, implement has<X>Section (write it?), put<X>Section (the body only) and
+// get<X>Section (reads and validates exactly the body) in io/grid_section_<x>.cpp, and list it in sectionCodecs()
+// in io/grid_file.cpp.
+#pragma once
+
+#include <cstdint>
+
+#include "io/byte_codec.h"
+#include "vox/core/grid.h"
+#include "vox/core/scene.h"
+
+namespace vox {
+
+enum class SectionTag : uint32_t { Textures = 1, SolidTextures = 2, Brick = 3 };
+
+struct SectionCodec {
+  SectionTag tag;
+  const char* name;  // for error messages
+  bool (*has)(const Scene&, const Grid&);
+  void (*put)(ByteWriter&, const Scene&, const Grid&);
+  void (*get)(ByteReader&, Scene&, Grid&);
+};
+
+
+}  // namespace vox

@@ -24,8 +24,8 @@ struct TextureSum {
 
 // Adds `texture` over the part of triangle `t` (texture coordinates `uv`) inside the closed box `box`: the clipped
 // polygon is split into a fan, and each piece is split into n x n equal triangles, each sampled (bilinearly) at its
-// centroid, with n growing with the texels the piece covers (1 to 16) so that coarse cells average over the texels
-// they cover, not a few of them. Never throws.
+// centroid, with n growing with the texels the piece covers (1 to 32) so that coarse cells average over the texels
+// they cover, not a few of them (beyond 1024 texels a piece, at stratified pseudo-random points: noise, not aliasing). Never throws.
 void addTextureOverBox(const Texture& texture, const std::array<Vec3, 3>& t, const std::array<TexCoord, 3>& uv,
                        const Box& box, TextureSum& sum);
 

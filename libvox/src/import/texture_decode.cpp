@@ -62,8 +62,11 @@ Texture decodeTexture(const std::string& bytes, const std::string& name, const s
   if (!in) fail<InputError>(where, ": no image reader for '", quoteInput(ext), "' files: ", oiioError(""));
   if (!in->supports("ioproxy")) fail<InputError>(where, ": '", quoteInput(ext), "' images cannot be read from memory");
   in->set_ioproxy(&proxy);
+  // Colours as stored: OIIO would otherwise premultiply PNG's unassociated alpha, blackening transparent texels.
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
   OIIO::ImageSpec spec;
-  if (!in->open(fakeName, spec)) fail<InputError>(where, ": cannot decode image: ", oiioError(in->geterror()));
+  if (!in->open(fakeName, spec, config)) fail<InputError>(where, ": cannot decode image: ", oiioError(in->geterror()));
   const int channels = spec.nchannels;
   if (spec.width <= 0 || spec.height <= 0 || spec.width > int(kMaxTextureSide) || spec.height > int(kMaxTextureSide))
     fail<InputError>(where, ": image size ", spec.width, "x", spec.height, " is not between 1 and ", kMaxTextureSide,

@@ -60,10 +60,11 @@ int runVoxelFormat(const Options& opt, vox::VoxelFormat format) {
     std::error_code sizeError;
     const auto bytes = std::filesystem::file_size(opt.output, sizeError);
     std::fprintf(stderr,
-                 "voxels: %llu\noccupied_cells: %zu\nsolid_cells: %llu\nmodels: %llu\ncolors: %u\n"
+                 "voxels: %llu\noccupied_cells: %zu\nsolid_cells: %llu\n%s: %llu\ncolors: %u\n"
                  "palette_colors: %u\noutput_bytes: %llu\nwrite_seconds: %.6f\ntotal_seconds: %.6f\n",
                  (unsigned long long)report.voxels, file.grid.occupiedCount(),
-                 (unsigned long long)file.grid.solidCount(), (unsigned long long)report.models, report.gridColors,
+                 (unsigned long long)file.grid.solidCount(), format == VoxelFormat::Vdb ? "vdb_leaf_nodes" : "models",
+                 (unsigned long long)report.models, report.gridColors,
                  report.paletteColors, (unsigned long long)(sizeError ? 0 : bytes), writeSeconds,
                  secondsSince(start));
   }

@@ -63,6 +63,7 @@ Material getMaterial(ByteReader& r) {
 // Every optional section this build reads and writes, in the order they are written. Add new sections here.
 const std::vector<SectionCodec>& sectionCodecs() {
   static const std::vector<SectionCodec> codecs = {
+      {SectionTag::Textures, "textures", hasTexturesSection, putTexturesSection, getTexturesSection},
   };
   return codecs;
 }

@@ -25,5 +25,10 @@ struct SectionCodec {
   void (*get)(ByteReader&, Scene&, Grid&);
 };
 
+// Textures (io/grid_section_textures.cpp): image textures, material texture indices, triangle texture coordinates.
+bool hasTexturesSection(const Scene& scene, const Grid& grid);
+void putTexturesSection(ByteWriter& w, const Scene& scene, const Grid& grid);
+void getTexturesSection(ByteReader& r, Scene& scene, Grid& grid);
+
 
 }  // namespace vox

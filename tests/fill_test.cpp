@@ -1,21 +1,35 @@
-// Solid fill: enclosed empty cells become solid, open surfaces enclose nothing.
+// Solid fill: closed surfaces by flood fill (cell for cell against a dense reference), open meshes by the winding
+// number (against brute force), spheres and ellipsoids against the exact cells of the closed solid, the open Stanford
+// bunny against its closed course twin.
 #include <gtest/gtest.h>
+
+#include <deque>
 
 #include "test_util.h"
 #include "vox/core/error.h"
+#include "vox/import/import.h"
 #include "vox/voxelize/fill.h"
 #include "vox/voxelize/voxelize.h"
+#include "vox/voxelize/winding_number.h"
 
 namespace vox {
 namespace {
 
-// A closed axis-aligned box surface [a, b]^3 of 12 triangles.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kSanitized = true;  // the sanitizer build runs the same checks on smaller grids
+#else
+constexpr bool kSanitized = false;
+#endif
+
+std::string seed(const std::string& rel) { return std::string(VOX_SEED_DIR) + "/" + rel; }
+
+// A closed axis-aligned box surface [a, b]^3 of 12 outward-oriented triangles.
 Scene boxScene(double a, double b) {
   Scene scene;
   scene.materials.push_back({});
   Vec3 p[8];
   for (int c = 0; c < 8; ++c) p[c] = {(c & 1) ? b : a, (c & 2) ? b : a, (c & 4) ? b : a};
-  const int quads[6][4] = {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}};
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
   for (const auto& q : quads) {
     scene.triangles.push_back({{p[q[0]], p[q[1]], p[q[2]]}});
     scene.triangles.push_back({{p[q[0]], p[q[2]], p[q[3]]}});
@@ -23,62 +37,245 @@ Scene boxScene(double a, double b) {
   return scene;
 }
 
+std::vector<uint8_t> solidMask(const Grid& g) {
+  std::vector<uint8_t> mask(g.cellCount(), 0);
+  for (const CellRun& r : g.solidRuns)
+    for (uint64_t key = r.first; key < r.first + r.count; ++key) mask[key] = 1;
+  return mask;
+}
+
+// Reference: breadth-first flood fill of single cells from every empty cell on the grid's faces; what it does not
+// reach is enclosed.
+std::vector<uint8_t> referenceEnclosed(const Grid& g) {
+  const auto d = g.dims;
+  std::vector<uint8_t> state(g.cellCount(), 0);  // 0 free, 1 occupied, 2 reached
+  for (uint64_t key : g.cellKeys) state[key] = 1;
+  std::deque<std::array<int64_t, 3>> queue;
+  auto visit = [&](int64_t i, int64_t j, int64_t k) {
+    if (i < 0 || j < 0 || k < 0 || i >= d[0] || j >= d[1] || k >= d[2]) return;
+    uint8_t& s = state[cellKey(d, i, j, k)];
+    if (s == 0) s = 2, queue.push_back({i, j, k});
+  };
+  for (int64_t k = 0; k < d[2]; ++k)
+    for (int64_t j = 0; j < d[1]; ++j)
+      for (int64_t i = 0; i < d[0]; ++i)
+        if (i == 0 || j == 0 || k == 0 || i == d[0] - 1 || j == d[1] - 1 || k == d[2] - 1) visit(i, j, k);
+  while (!queue.empty()) {
+    const auto [i, j, k] = queue.front();
+    queue.pop_front();
+    visit(i - 1, j, k), visit(i + 1, j, k), visit(i, j - 1, k), visit(i, j + 1, k), visit(i, j, k - 1),
+        visit(i, j, k + 1);
+  }
+  std::vector<uint8_t> enclosed(g.cellCount());
+  for (uint64_t c = 0; c < enclosed.size(); ++c) enclosed[c] = state[c] == 0;
+  return enclosed;
+}
+
+void expectRunsWellFormed(const Grid& g) {
+  EXPECT_NO_THROW(checkSolidRuns(g.solidRuns, g.cellCount(), "fill"));
+  for (const CellRun& r : g.solidRuns)
+    for (uint64_t key = r.first; key < r.first + r.count; ++key) ASSERT_LT(findCell(g, key), 0) << key;
+}
+
 TEST(Fill, ClosedBoxInteriorIsSolid) {
-  // Box faces at 0.1 and 0.9 inside [0, 1] with 10 cells: faces lie inside cells 1 and 8 (not on boundaries), so the
-  // shell is one cell thick and the interior is cells 2..7 on each axis.
+  // Faces at 0.15 and 0.85 in [0, 1] with 10 cells: inside cells 1 and 8, so the interior is cells 2..7 per axis.
   Scene scene = boxScene(0.15, 0.85);
   VoxelizeOptions opt;
   opt.bounds = Box{{0, 0, 0}, {1, 1, 1}};
   opt.dims = {10, 10, 10};
   Grid grid = voxelizeScene(scene, opt);
-  fillSolid(grid, 1 << 20);
+  const FillReport report = fillSolid(grid, scene);
+  EXPECT_EQ(report.rule, FillRule::Enclosed);
+  EXPECT_EQ(report.openEdges, 0u);
   EXPECT_EQ(grid.solidCount(), 6u * 6 * 6);
-  std::vector<uint64_t> solidKeys;
+  EXPECT_EQ(report.solidCells, grid.solidCount());
+  EXPECT_EQ(grid.solidRuns.size(), 6u * 6);  // one run per row
   for (const CellRun& r : grid.solidRuns)
-    for (uint64_t key = r.first; key < r.first + r.count; ++key) solidKeys.push_back(key);
-  for (uint64_t key : solidKeys) {
-    const auto ijk = cellIndex(grid.dims, key);
-    for (int a = 0; a < 3; ++a) {
-      EXPECT_GE(ijk[a], 2u);
-      EXPECT_LE(ijk[a], 7u);
+    for (uint64_t key = r.first; key < r.first + r.count; ++key) {
+      const auto ijk = cellIndex(grid.dims, key);
+      for (int a = 0; a < 3; ++a) EXPECT_TRUE(ijk[a] >= 2 && ijk[a] <= 7) << key;
     }
-  }
+  EXPECT_EQ(describeFill(report), "closed surface, 216 solid cells");
+  EXPECT_EQ(fillWarning(report), "");
 }
 
-TEST(Fill, OpenSurfaceEnclosesNothingAndSphereIsFilled) {
-  Scene scene = boxScene(0.15, 0.85);
-  scene.triangles.pop_back();
-  scene.triangles.pop_back();  // one face removed: the box is open
-  VoxelizeOptions opt;
-  opt.bounds = Box{{0, 0, 0}, {1, 1, 1}};
-  opt.dims = {10, 10, 10};
-  Grid open = voxelizeScene(scene, opt);
-  fillSolid(open, 1 << 20);
-  EXPECT_TRUE(open.solidRuns.empty());
+// The run-based flood fill against the dense reference on random soups of triangles, spheres and ellipsoids,
+// including grids one cell thick, where every cell is on the grid's boundary.
+TEST(Fill, EnclosedRunsEqualDenseFloodFill) {
+  const std::array<uint32_t, 3> dims[] = {{23, 17, 19}, {40, 1, 30}, {1, 25, 25}, {31, 29, 2}, {7, 64, 9}};
+  int checked = 0;
+  for (uint32_t s = 0; s < 12; ++s) {
+    Scene scene = testing::randomScene(900 + s, 40 + 10 * int(s), 6);
+    scene.triangles.clear();  // closed surfaces only, so that the rule is the flood fill
+    const Scene box = boxScene(0.05 + 0.01 * s, 0.9);
+    scene.triangles = box.triangles;
+    VoxelizeOptions opt;
+    opt.dims = dims[s % std::size(dims)];
+    Grid g = voxelizeScene(scene, opt);
+    const FillReport report = fillSolid(g, scene);
+    ASSERT_EQ(report.rule, FillRule::Enclosed);
+    expectRunsWellFormed(g);
+    const auto want = referenceEnclosed(g), got = solidMask(g);
+    uint64_t wantCount = 0;
+    for (uint64_t c = 0; c < want.size(); ++c) {
+      ASSERT_EQ(got[c], want[c]) << "scene " << s << " cell " << c;
+      wantCount += want[c];
+    }
+    EXPECT_EQ(report.solidCells, wantCount);
+    checked += wantCount > 0;
+  }
+  EXPECT_GE(checked, 4);  // the comparison saw interiors (grids one cell thick have none)
+}
 
-  Scene ball;
-  ball.materials.push_back({});
-  ball.spheres.push_back({{0, 0, 0}, 1, {}, 0});
-  VoxelizeOptions so;
-  so.dims = {15, 15, 15};
-  Grid g = voxelizeScene(ball, so);
-  fillSolid(g, 1 << 20);
-  // Every solid cell is strictly inside the ball and every empty cell strictly inside it is solid.
-  size_t inside = 0;
-  for (uint32_t k = 0; k < 15; ++k)
-    for (uint32_t j = 0; j < 15; ++j)
-      for (uint32_t i = 0; i < 15; ++i) {
+// DESIGN.md: a solid cell lies inside and meets no surface, so occupied or solid is exactly "meets the closed solid".
+// For an axis-aligned ellipsoid (x/a)^2 + (y/b)^2 + (z/c)^2 <= 1 the nearest and farthest points of a box are found
+// axis by axis.
+void expectExactSolid(const Sphere& s, const Vec3& semi, const std::array<uint32_t, 3>& dims) {
+  Scene scene;
+  scene.materials.push_back({});
+  scene.spheres.push_back(s);
+  VoxelizeOptions opt;
+  opt.dims = dims;
+  Grid g = voxelizeScene(scene, opt);
+  const FillReport report = fillSolid(g, scene);
+  EXPECT_EQ(report.rule, FillRule::Enclosed);
+  expectRunsWellFormed(g);
+  const auto solid = solidMask(g);
+  uint64_t inside = 0;
+  for (uint32_t k = 0; k < dims[2]; ++k)
+    for (uint32_t j = 0; j < dims[1]; ++j)
+      for (uint32_t i = 0; i < dims[0]; ++i) {
         const Box b = cellBox(g, i, j, k);
+        double nearQ = 0, farQ = 0;
+        for (int a = 0; a < 3; ++a) {
+          const double lo = (b.lo[a] - s.center[a]) / semi[a], hi = (b.hi[a] - s.center[a]) / semi[a];
+          const double nearest = lo > 0 ? lo : (hi < 0 ? hi : 0);
+          nearQ += nearest * nearest;
+          farQ += std::max(lo * lo, hi * hi);
+        }
         const uint64_t key = cellKey(g.dims, i, j, k);
         const bool occupied = findCell(g, key) >= 0;
-        double far = 0;
-        for (int a = 0; a < 3; ++a) far += std::max(b.lo[a] * b.lo[a], b.hi[a] * b.hi[a]);
-        const bool solid = isSolid(g, key);
-        if (!occupied && far < 1) ++inside;
-        EXPECT_EQ(solid, !occupied && far < 1) << i << " " << j << " " << k;
+        ASSERT_EQ(occupied || solid[key], nearQ <= 1) << i << " " << j << " " << k;
+        inside += solid[key];
+        if (!occupied) {
+          ASSERT_EQ(solid[key], farQ < 1) << i << " " << j << " " << k;
+        }
       }
-  EXPECT_GT(inside, 100u);
-  EXPECT_THROW(fillSolid(g, 10), LimitError);
+  EXPECT_GT(inside, uint64_t(dims[0]) * dims[1] * dims[2] / 8);
+}
+
+TEST(Fill, SphereAndEllipsoidEqualTheClosedSolid) {
+  const uint32_t n = kSanitized ? 21 : 47;
+  expectExactSolid({{0.1, -0.2, 0.3}, 1, {}, 0}, {1, 1, 1}, {n, n, n});
+  expectExactSolid({{0, 0, 0}, 0.75, {}, 0}, {0.75, 0.75, 0.75}, {n, n + 4, n - 6});
+  Sphere e{{0, 0, 0}, 1, scaling({1.5, 0.6, 1.1}), 0};
+  expectExactSolid(e, {1.5, 0.6, 1.1}, {n + 2, n, n - 3});
+}
+
+// Flood fill and the winding number agree on a closed mesh (the winding number is 1 inside it, 0 outside).
+TEST(Fill, CourseBunnyWindingNumberEqualsFloodFill) {
+  const Scene bunny = loadScene(seed(kSanitized ? "6837/scenes/bunny_1k.obj" : "6837/scenes/bunny_40k.obj"));
+  VoxelizeOptions opt;
+  opt.resolution = kSanitized ? 24 : 64;
+  Grid flood = voxelizeScene(bunny, opt);
+  const FillReport closed = fillSolid(flood, bunny);
+  ASSERT_EQ(closed.rule, FillRule::Enclosed) << closed.openEdges;
+  EXPECT_GT(closed.solidCells, 1000u);
+  const auto want = referenceEnclosed(flood), got = solidMask(flood);
+  EXPECT_EQ(got, want);
+  // The same gaps decided by winding number alone: every enclosed run has |w| >= 0.5, every other < 0.5.
+  Grid winding = flood;
+  FillOptions fo;
+  fo.rule = FillRule::WindingNumber;
+  fo.windingOnly = true;
+  const FillReport w = fillSolid(winding, bunny, fo);
+  EXPECT_EQ(w.enclosedCells, 0u);
+  EXPECT_GT(w.windingQueries, 0u);
+  EXPECT_EQ(solidMask(winding), want);
+}
+
+TEST(Fill, OpenBoxIsReportedOpenAndFilledByWindingNumber) {
+  Scene scene = boxScene(0.15, 0.85);
+  scene.triangles.resize(10);  // the last face (x = 0.85) removed: a large hole
+  VoxelizeOptions opt;
+  opt.bounds = Box{{0, 0, 0}, {1, 1, 1}};
+  opt.dims = {20, 20, 20};
+  Grid g = voxelizeScene(scene, opt);
+  const FillReport report = fillSolid(g, scene);
+  EXPECT_EQ(report.rule, FillRule::WindingNumber);
+  EXPECT_EQ(report.openEdges, 4u);  // the square rim of the hole
+  EXPECT_EQ(report.enclosedCells, 0u);
+  EXPECT_GT(report.windingQueries, 0u);
+  expectRunsWellFormed(g);
+  // Brute force: every empty cell between two occupied cells of its row is solid when the exact winding number at
+  // its run's middle cell is at least 0.5; and per cell, the exact winding number at each cell's own centre agrees
+  // with the run's decision almost everywhere (the runs end at the surface, except near the hole).
+  const auto solid = solidMask(g);
+  uint64_t cells = 0, disagree = 0;
+  for (uint32_t k = 0; k < 20; ++k)
+    for (uint32_t j = 0; j < 20; ++j)
+      for (uint32_t i = 0; i < 20; ++i) {
+        const uint64_t key = cellKey(g.dims, i, j, k);
+        if (findCell(g, key) >= 0) continue;
+        const Box b = cellBox(g, i, j, k);
+        const double w = windingNumberExact(scene.triangles, (b.lo + b.hi) * 0.5);
+        ++cells;
+        disagree += solid[key] != (std::abs(w) >= 0.5);
+      }
+  EXPECT_GT(report.solidCells, 5u * 5 * 5);
+  EXPECT_LT(double(disagree), 0.02 * double(cells)) << disagree << " of " << cells;
+  EXPECT_NE(describeFill(report).find("mesh has 4 open edges"), std::string::npos) << describeFill(report);
+}
+
+// The scanned bunny (holes in its base) fills like the course's closed bunny of the same shape (twice its size).
+TEST(Fill, OpenStanfordBunnyFillsLikeItsClosedTwin) {
+  const uint32_t res = kSanitized ? 48 : 128;
+  const Scene open = loadScene(seed("meshes/bun_zipper.ply"));
+  const Scene closed = loadScene(seed("6837/scenes/bunny_40k.obj"));
+  VoxelizeOptions opt;
+  opt.resolution = res;
+  Grid go = voxelizeScene(open, opt), gc = voxelizeScene(closed, opt);
+  const FillReport ro = fillSolid(go, open), rc = fillSolid(gc, closed);
+  EXPECT_EQ(rc.rule, FillRule::Enclosed);
+  EXPECT_EQ(ro.rule, FillRule::WindingNumber);
+  EXPECT_GT(ro.openEdges, 0u);
+  EXPECT_GT(rc.solidCells, 1000u);
+  const double ratio = double(ro.solidCells + go.occupiedCount()) / double(rc.solidCells + gc.occupiedCount());
+  EXPECT_NEAR(ratio, 1.0, 0.03) << ro.solidCells << " + " << go.occupiedCount() << " vs " << rc.solidCells << " + "
+                                << gc.occupiedCount();
+  EXPECT_EQ(fillWarning(ro), "");
+}
+
+TEST(Fill, SuspiciousResultsAreNamedAndBudgetIsChecked) {
+  // User bounds wholly inside a closed box: no cell meets the surface and every cell is inside.
+  Scene scene = boxScene(0, 1);
+  VoxelizeOptions opt;
+  opt.bounds = Box{{0.4, 0.4, 0.4}, {0.6, 0.6, 0.6}};
+  opt.dims = {4, 4, 4};
+  Grid inside = voxelizeScene(scene, opt);
+  FillReport r = fillSolid(inside, scene);
+  EXPECT_EQ(r.solidCells, 0u);  // an empty row is a single run from face to face: outside
+  EXPECT_NE(fillWarning(r).find("nothing filled"), std::string::npos);
+  // A closed surface on the grid's faces: nothing is outside.
+  opt.bounds = Box{{0, 0, 0}, {1, 1, 1}};
+  Grid whole = voxelizeScene(scene, opt);
+  r = fillSolid(whole, scene);
+  EXPECT_EQ(r.solidCells, 8u);
+  EXPECT_EQ(fillWarning(r), "");  // exact under the flood fill
+  FillOptions winding;
+  winding.rule = FillRule::WindingNumber;
+  winding.windingOnly = true;
+  r = fillSolid(whole, scene, winding);
+  EXPECT_EQ(r.windingCells, 8u);
+  EXPECT_NE(fillWarning(r).find("every empty cell"), std::string::npos);
+
+  FillOptions tiny;
+  tiny.memoryLimitBytes = 64;
+  EXPECT_THROW(fillSolid(whole, scene, tiny), LimitError);
+  FillOptions cancel;
+  cancel.rule = FillRule::WindingNumber;
+  cancel.progress = [](double) { return false; };
+  EXPECT_THROW(fillSolid(whole, scene, cancel), Error);
 }
 
 }  // namespace

@@ -349,7 +349,7 @@ void voxelizeOne(const Options& opt, const std::string& scenePath, const std::st
   const Scene scene = loadScene(scenePath);
   Grid grid = namingScene(scenePath, [&] {
     Grid g = voxelizeScene(scene, vo);
-    if (opt.fill) fillSolid(g, vo.memoryLimitBytes);
+    if (opt.fill) fillSolid(g, scene, FillOptions{vo.memoryLimitBytes, {}, {}, false});
     return g;
   });
   writeGridFile(output, scene, grid);

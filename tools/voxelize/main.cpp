@@ -101,7 +101,21 @@ int run(const Options& opt) {
   try {
     grid = voxelizeScene(scene, vo, &stats);
     bar.finish();
-    if (opt.fill) fillSolid(grid, vo.memoryLimitBytes);
+    if (opt.fill) {
+      ProgressBar fillBar("filling", opt.common.quiet);
+      FillOptions fo;
+      fo.memoryLimitBytes = vo.memoryLimitBytes;
+      fo.progress = [&](double f) {
+        fillBar.update(f);
+        return true;
+      };
+      const FillReport report = fillSolid(grid, scene, fo);
+      fillBar.finish();
+      // How the fill decided is always said (an open mesh once filled nothing, silently).
+      if (!opt.common.quiet) std::fprintf(stderr, "vox-voxelize: fill: %s\n", describeFill(report).c_str());
+      if (const std::string w = fillWarning(report); !w.empty() && !opt.common.quiet)
+        std::fprintf(stderr, "vox-voxelize: warning: %s: fill: %s\n", opt.scene.c_str(), w.c_str());
+    }
   } catch (const LimitError& e) {
     fail<LimitError>(opt.scene, ": ", e.what());  // what the scene asks for is named with the scene
   } catch (const InputError& e) {
@@ -146,7 +160,9 @@ int main(int argc, char** argv) {
                  "Overlap test: exact (CGAL exact predicates, default), sat (floating-point separating axes), "
                  "bbox (primitive bounding box, superset), center (cell centre in footprint, misses cells)")
       ->check(CLI::IsMember({"exact", "sat", "bbox", "center"}));
-  app.add_flag("--fill", opt.fill, "Also mark the empty cells inside closed surfaces as solid");
+  app.add_flag("--fill", opt.fill,
+               "Also mark the empty cells inside the surfaces as solid: flood fill for closed meshes, |winding "
+               "number| >= 0.5 for open ones; says which on stderr");
   app.add_option("--bricks", opt.bricks,
                  "Write a grid set: OUT is a manifest naming one grid file per non-empty brick of BX x BY x BZ "
                  "bricks (in OUT_NAME.bricks/ beside it), voxelized one brick at a time")

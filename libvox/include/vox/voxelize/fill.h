@@ -1,16 +1,67 @@
-// Solid fill (DESIGN.md "Solid fill"): marks the empty cells enclosed by occupied cells as solid.
+// Solid fill (DESIGN.md "Solid fill"): marks the empty cells inside the scene's solids as solid, stored as runs.
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
 
 #include "vox/core/grid.h"
+#include "vox/core/scene.h"
 
 namespace vox {
 
-// Fills grid.solidRuns with every empty cell that no 6-connected path of empty cells joins to the outside of the
-// grid. An exact (conservative) voxelization of a closed surface leaves no such path through the surface, so these
-// are exactly the empty cells inside closed surfaces; an open surface encloses nothing. Needs one bit per grid cell
-// of scratch memory: throws LimitError when that exceeds `memoryLimitBytes`.
-void fillSolid(Grid& grid, uint64_t memoryLimitBytes);
+// How fillSolid decided what is inside.
+enum class FillRule : uint8_t {
+  // Every triangle edge is shared by an even number of triangles (spheres are closed too): a cell is solid when no
+  // 6-connected path of empty cells joins it to the outside of the grid. Exact for a conservative (exact, sat, bbox)
+  // voxelization of closed surfaces: the cells inside that meet no surface.
+  Enclosed,
+  // The mesh has open edges, or the voxelization (`center`) leaves gaps in closed surfaces: the enclosed cells as
+  // above, and also the cells of the other empty runs along x (in rows that hold a surface cell) whose centre has a
+  // generalized winding number (winding_number.h, spheres counting 1 inside) of magnitude at least
+  // kWindingThreshold. Evaluated at both ends of each run; a run whose ends disagree is split by bisection.
+  WindingNumber,
+};
+
+// 0.5 is the midpoint between outside (0) and inside (1) of Jacobson et al. 2013; the magnitude is used so that a
+// mesh oriented inward (a common scanner output) fills like its outward twin.
+inline constexpr double kWindingThreshold = 0.5;
+
+struct FillOptions {
+  uint64_t memoryLimitBytes = 16ull << 30;  // scratch beyond this throws LimitError, before allocating
+  // Called with a fraction in [0, 1], possibly from worker threads; return false to cancel (throws vox::Error).
+  std::function<bool(double)> progress;
+  // For tests and comparisons: this rule instead of the one chosen from the mesh; with windingOnly, the
+  // WindingNumber rule decides the enclosed runs by winding number too.
+  std::optional<FillRule> rule;
+  bool windingOnly = false;
+};
+
+struct FillReport {
+  FillRule rule = FillRule::Enclosed;
+  uint64_t openEdges = 0;        // countOpenEdges of the scene's triangles
+  bool leakyMethod = false;      // the grid's method is `center`, whose surfaces have gaps
+  uint64_t enclosedCells = 0;    // solid because enclosed (both rules)
+  uint64_t windingCells = 0;     // solid because of the winding number (WindingNumber rule only)
+  uint64_t windingQueries = 0;   // winding numbers evaluated
+  uint64_t solidCells = 0;       // enclosedCells + windingCells == grid.solidCount()
+  uint64_t emptyCells = 0;       // cells holding no primitive
+};
+
+// Sets grid.solidRuns (replacing what it held) from `scene`, the scene `grid` was voxelized from. Works on runs of
+// empty cells along x, never on single cells: scratch memory is about 60 bytes per occupied cell plus the
+// winding-number tree (300 bytes per triangle), whatever the grid's dimensions. Work is spread over the TBB arena
+// of the caller. Throws LimitError when the scratch memory exceeds options.memoryLimitBytes, vox::Error when
+// cancelled. Precondition: grid.cellKeys sorted (as voxelizeScene makes them).
+FillReport fillSolid(Grid& grid, const Scene& scene, const FillOptions& options = {});
+
+// One line saying how the fill decided, for the tools' stderr: "closed surface, 389351 solid cells", or
+// "|winding number| >= 0.5 (mesh has 212 open edges), 2996 solid cells (0 enclosed, 2996 by winding number of
+// 1520 runs)".
+std::string describeFill(const FillReport& report);
+// A warning when the result is suspicious (nothing filled although there is room, or every empty cell filled by
+// winding number); empty otherwise.
+std::string fillWarning(const FillReport& report);
 
 }  // namespace vox

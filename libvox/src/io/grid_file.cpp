@@ -64,6 +64,8 @@ Material getMaterial(ByteReader& r) {
 const std::vector<SectionCodec>& sectionCodecs() {
   static const std::vector<SectionCodec> codecs = {
       {SectionTag::Textures, "textures", hasTexturesSection, putTexturesSection, getTexturesSection},
+      {SectionTag::SolidTextures, "solid textures", hasSolidTexturesSection, putSolidTexturesSection,
+       getSolidTexturesSection},
   };
   return codecs;
 }

@@ -30,5 +30,9 @@ bool hasTexturesSection(const Scene& scene, const Grid& grid);
 void putTexturesSection(ByteWriter& w, const Scene& scene, const Grid& grid);
 void getTexturesSection(ByteReader& r, Scene& scene, Grid& grid);
 
+// SolidTextures (io/grid_section_solid_textures.cpp): the course's Checkerboard, Noise, Marble and Wood materials.
+bool hasSolidTexturesSection(const Scene& scene, const Grid& grid);
+void putSolidTexturesSection(ByteWriter& w, const Scene& scene, const Grid& grid);
+void getSolidTexturesSection(ByteReader& r, Scene& scene, Grid& grid);
 
 }  // namespace vox

@@ -68,6 +68,13 @@ std::string plain(const GridFile& file) {
   out << "spheres: " << sc.spheres.size() << " (" << s.ellipsoids << " ellipsoids)\n";
   out << "planes: " << sc.planes.size() << "\n";
   out << "materials: " << sc.materials.size() << "\n";
+  out << "solid_textures: " << sc.solidTextures.size();
+  for (SolidKind k : {SolidKind::Checkerboard, SolidKind::Noise, SolidKind::Marble, SolidKind::Wood}) {
+    const auto n = std::count_if(sc.solidTextures.begin(), sc.solidTextures.end(),
+                                 [&](const SolidTexture& t) { return t.kind == k; });
+    if (n > 0) out << " " << solidKindName(k) << ":" << n;
+  }
+  out << "\n";
   out << "lights: " << sc.lights.size() << "\n";
   out << "camera: " << (sc.camera ? (sc.camera->kind == CameraKind::Perspective ? "perspective" : "orthographic") : "none") << "\n";
   out << "occupied_cells: " << g.occupiedCount() << "\n";
@@ -103,6 +110,16 @@ std::string json(const GridFile& file, const InfoOptions& options) {
   out << "  \"references\": " << g.referenceCount() << ",\n";
   out << "  \"outside_primitives\": " << g.outsidePrims.size() << ",\n";
   out << "  \"memory_bytes\": " << s.memoryBytes << ",\n";
+  // Solid textures by the material that uses them (the course's Checkerboard, Noise, Marble, Wood).
+  out << "  \"solid_textures\": [";
+  for (size_t m = 0, n = 0; m < sc.materials.size(); ++m) {
+    if (sc.materials[m].solidTexture == kNoSolidTexture) continue;
+    const SolidTexture& t = sc.solidTextures[sc.materials[m].solidTexture];
+    out << (n++ ? ", " : "") << "{\"material\": " << m << ", \"kind\": " << jsonString(solidKindName(t.kind))
+        << ", \"materials\": [" << t.materials[0] << ", " << t.materials[1] << "], \"octaves\": " << t.octaves
+        << ", \"frequency\": " << num(t.frequency) << ", \"amplitude\": " << num(t.amplitude) << "}";
+  }
+  out << "],\n";
   out << "  \"histogram\": {";
   bool first = true;
   for (const auto& [k, n] : s.histogram) {

@@ -280,6 +280,59 @@ Grid voxelizeBrick(const Scene& scene, const Grid& plan, const CellWindow& windo
 
 namespace {
 
+// One thread's references (packed key << primBits | id when key and id fit 64 bits, else pairs) and counters.
+struct Local {
+  std::vector<uint64_t> packedRefs;
+  std::vector<std::pair<uint64_t, uint32_t>> pairRefs;
+  uint64_t tested = 0, fallbacks = 0, degenerate = 0;
+};
+
+// Gathers the references of all threads into grid's compressed cell lists, grouped by cell in key order with ids
+// ascending; returns the summed counters (seconds not set).
+VoxelizeStats gatherReferences(tbb::enumerable_thread_specific<Local>& locals, bool packed, int primBits,
+                               int keyBits, Grid& grid) {
+  const uint64_t primMask = (uint64_t(1) << primBits) - 1;
+  VoxelizeStats local{};
+  size_t total = 0;
+  for (auto& l : locals) {
+    total += packed ? l.packedRefs.size() : l.pairRefs.size();
+    local.cellsTested += l.tested;
+    local.exactFallbacks += l.fallbacks;
+    local.degenerateTriangles += l.degenerate;
+  }
+  grid.primIds.reserve(total);
+  grid.cellKeys.clear();
+  grid.cellStart.clear();
+  auto appendRef = [&](uint64_t key, uint32_t prim) {
+    if (grid.cellKeys.empty() || grid.cellKeys.back() != key) {
+      grid.cellKeys.push_back(key);
+      grid.cellStart.push_back(grid.primIds.size());
+    }
+    grid.primIds.push_back(prim);
+  };
+  if (packed) {
+    std::vector<uint64_t> all;
+    all.reserve(total);
+    for (auto& l : locals) {
+      all.insert(all.end(), l.packedRefs.begin(), l.packedRefs.end());
+      std::vector<uint64_t>().swap(l.packedRefs);
+    }
+    radixSort(all, primBits + keyBits);
+    for (uint64_t x : all) appendRef(x >> primBits, uint32_t(x & primMask));
+  } else {
+    std::vector<std::pair<uint64_t, uint32_t>> all;
+    all.reserve(total);
+    for (auto& l : locals) {
+      all.insert(all.end(), l.pairRefs.begin(), l.pairRefs.end());
+      std::vector<std::pair<uint64_t, uint32_t>>().swap(l.pairRefs);
+    }
+    tbb::parallel_sort(all.begin(), all.end());
+    for (const auto& [key, prim] : all) appendRef(key, prim);
+  }
+  grid.cellStart.push_back(grid.primIds.size());
+  return local;
+}
+
 // Voxelizes the primitives `ids` into the cells of `window` of the planned `grid`. A primitive's cell tests are the
 // same whatever the window (the filter's error bounds come from its whole cell range), so a brick gets exactly the
 // single grid's cells restricted to it, for every method.
@@ -309,13 +362,7 @@ void voxelizeWindow(const Scene& scene, Grid& grid, const CellWindow& window, co
   const int primBits = std::max(1, int(std::bit_width(uint64_t(nBounded - 1))));
   const int keyBits = int(std::bit_width(grid.cellCount() - 1));
   const bool packed = primBits + keyBits <= 64;
-  const uint64_t primMask = (uint64_t(1) << primBits) - 1;
 
-  struct Local {
-    std::vector<uint64_t> packedRefs;
-    std::vector<std::pair<uint64_t, uint32_t>> pairRefs;
-    uint64_t tested = 0, fallbacks = 0, degenerate = 0;
-  };
   tbb::enumerable_thread_specific<Local> locals;
   std::atomic<size_t> done{0};
   std::atomic<bool> cancelled{false};
@@ -447,45 +494,7 @@ void voxelizeWindow(const Scene& scene, Grid& grid, const CellWindow& window, co
   });
   if (cancelled) fail<Error>("voxelization cancelled");
 
-  // Gather the references of all threads and group them by cell.
-  VoxelizeStats local{};
-  size_t total = 0;
-  for (auto& l : locals) {
-    total += packed ? l.packedRefs.size() : l.pairRefs.size();
-    local.cellsTested += l.tested;
-    local.exactFallbacks += l.fallbacks;
-    local.degenerateTriangles += l.degenerate;
-  }
-  grid.primIds.reserve(total);
-  grid.cellKeys.clear();
-  grid.cellStart.clear();
-  auto appendRef = [&](uint64_t key, uint32_t prim) {
-    if (grid.cellKeys.empty() || grid.cellKeys.back() != key) {
-      grid.cellKeys.push_back(key);
-      grid.cellStart.push_back(grid.primIds.size());
-    }
-    grid.primIds.push_back(prim);
-  };
-  if (packed) {
-    std::vector<uint64_t> all;
-    all.reserve(total);
-    for (auto& l : locals) {
-      all.insert(all.end(), l.packedRefs.begin(), l.packedRefs.end());
-      std::vector<uint64_t>().swap(l.packedRefs);
-    }
-    radixSort(all, primBits + keyBits);
-    for (uint64_t x : all) appendRef(x >> primBits, uint32_t(x & primMask));
-  } else {
-    std::vector<std::pair<uint64_t, uint32_t>> all;
-    all.reserve(total);
-    for (auto& l : locals) {
-      all.insert(all.end(), l.pairRefs.begin(), l.pairRefs.end());
-      std::vector<std::pair<uint64_t, uint32_t>>().swap(l.pairRefs);
-    }
-    tbb::parallel_sort(all.begin(), all.end());
-    for (const auto& [key, prim] : all) appendRef(key, prim);
-  }
-  grid.cellStart.push_back(grid.primIds.size());
+  VoxelizeStats local = gatherReferences(locals, packed, primBits, keyBits, grid);
   if (options.progress) options.progress(1.0);
   local.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (stats) *stats = local;

@@ -4,12 +4,16 @@
 //   open. Every byte decoded is the caller's, already read through input_file.h (folder and size checks).
 // - open, read_image report failure by return value and geterror(); the JPEG reader turns libjpeg's fatal errors
 //   into a failed read (its error manager longjmps back), it does not exit.
+// - the PNG reader leaves libpng's default error handler in place, which prints "libpng error: ..." on stderr
+//   before OIIO reports the failure: the library must not print, so PNG chunks (lengths, CRCs, IEND) are checked
+//   here first, which refuses truncated and corrupted files before libpng sees them.
 #include "import/texture_decode.h"
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <filesystem>
 #include <vector>
@@ -34,6 +38,41 @@ std::string formatExtension(const std::string& bytes, const std::string& name) {
   return ext;
 }
 
+// PNG's CRC-32 (ISO 3309, as in the PNG specification's annex D), over a chunk's type and data.
+uint32_t pngCrc(const unsigned char* p, size_t n) {
+  static const std::array<uint32_t, 256> table = [] {
+    std::array<uint32_t, 256> t{};
+    for (uint32_t i = 0; i < 256; ++i) {
+      uint32_t c = i;
+      for (int k = 0; k < 8; ++k) c = c & 1 ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+      t[i] = c;
+    }
+    return t;
+  }();
+  uint32_t c = 0xFFFFFFFFu;
+  for (size_t i = 0; i < n; ++i) c = table[(c ^ p[i]) & 0xFF] ^ (c >> 8);
+  return c ^ 0xFFFFFFFFu;
+}
+
+// Walks the chunks of a PNG: each must lie inside the bytes with a matching CRC, up to IEND.
+void checkPngChunks(const std::string& bytes, const std::string& where) {
+  const auto* p = reinterpret_cast<const unsigned char*>(bytes.data());
+  auto be32 = [&](size_t at) { return uint32_t(p[at]) << 24 | uint32_t(p[at + 1]) << 16 | uint32_t(p[at + 2]) << 8 | p[at + 3]; };
+  size_t at = 8;  // after the signature
+  while (true) {
+    if (bytes.size() - at < 12) fail<InputError>(where, ": PNG truncated at byte ", bytes.size(), " (no IEND chunk)");
+    const uint32_t length = be32(at);
+    if (length > bytes.size() - at - 12)
+      fail<InputError>(where, ": PNG chunk at byte ", at, " of ", length, " bytes runs past the end (", bytes.size(),
+                       " bytes)");
+    if (pngCrc(p + at + 4, size_t(length) + 4) != be32(at + 8 + length))
+      fail<InputError>(where, ": PNG chunk at byte ", at, ": CRC mismatch (corrupt file)");
+    const bool end = std::memcmp(p + at + 4, "IEND", 4) == 0;
+    at += size_t(length) + 12;
+    if (end) return;
+  }
+}
+
 std::string oiioError(const std::string& message) {
   std::string m = message.empty() ? OIIO::geterror() : message;
   while (!m.empty() && (m.back() == '\n' || m.back() == ' ')) m.pop_back();
@@ -56,6 +95,7 @@ void toRgb(const std::vector<uint8_t>& pixels, int channels, std::vector<uint8_t
 Texture decodeTexture(const std::string& bytes, const std::string& name, const std::string& where) {
   const std::string ext = formatExtension(bytes, name);
   if (ext.empty()) fail<InputError>(where, ": unknown image format (no known signature or extension)");
+  if (ext == ".png") checkPngChunks(bytes, where);
   const std::string fakeName = "texture" + ext;
   OIIO::Filesystem::IOMemReader proxy(bytes.data(), bytes.size());
   auto in = OIIO::ImageInput::create(fakeName, false, nullptr, &proxy);

@@ -203,17 +203,63 @@ TEST(ImportCourse, Scene2_13SquashedRotatedSphereIsAnEllipsoid) {
   EXPECT_EQ(e.transform.m[2][2], 1);
 }
 
-TEST(ImportCourse, Scene6_15ProceduralMaterialsTakeTheirFirstColour) {
+TEST(ImportCourse, Scene6_15SolidTexturesAreKept) {
   const Scene s = loadScene(course("scene6_15_marble_cubes.txt"));
   ASSERT_EQ(s.materials.size(), 12u);
   EXPECT_EQ(s.triangles.size(), 48u);
-  for (size_t procedural : {2u, 5u, 8u, 11u}) {
-    const Vec3 first = s.materials[procedural - 2].diffuse;
-    expectNear(s.materials[procedural].diffuse, first, 0);
+  ASSERT_EQ(s.solidTextures.size(), 4u);
+  const SolidKind kinds[] = {SolidKind::Noise, SolidKind::Noise, SolidKind::Marble, SolidKind::Marble};
+  const uint32_t octaves[] = {1, 5, 0, 5};
+  const double amplitudes[] = {1, 1, 3, 2};
+  for (size_t k = 0; k < 4; ++k) {
+    const size_t m = 3 * k + 2;
+    ASSERT_EQ(s.materials[m].solidTexture, k);
+    const SolidTexture& t = s.solidTextures[k];
+    EXPECT_EQ(t.kind, kinds[k]);
+    EXPECT_EQ(t.materials[0], m - 2);
+    EXPECT_EQ(t.materials[1], m - 1);
+    EXPECT_EQ(t.octaves, octaves[k]);
+    if (t.kind == SolidKind::Marble) {
+      EXPECT_EQ(t.frequency, 3);
+      EXPECT_EQ(t.amplitude, amplitudes[k]);
+    }
+    // The plain fields are the first material's, for tools that draw one colour per material.
+    expectNear(s.materials[m].diffuse, s.materials[m - 2].diffuse, 0);
   }
-  EXPECT_EQ(countWarnings(s, "Noise"), 2u);
-  EXPECT_EQ(countWarnings(s, "Marble"), 2u);
+  // The first texture's Transform { UniformScale 2 YRotate 20 XRotate -20 Translate 1.5 -1.5 0 }, composed as
+  // the course composes ops (M = M * Op).
+  const Mat4 expected = scaling({2, 2, 2}) * rotation({0, 1, 0}, 20) * rotation({1, 0, 0}, -20) *
+                        translation({1.5, -1.5, 0});
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) EXPECT_NEAR(s.solidTextures[0].transform.m[r][c], expected.m[r][c], 1e-15);
+  EXPECT_TRUE(s.warnings.empty());
   for (const auto& t : s.triangles) EXPECT_TRUE(t.material % 3 == 2);
+}
+
+TEST(ImportCourse, SolidTexturesNestAndRefuseForwardReferences) {
+  // scene6_18: a Checkerboard of two Woods.
+  const Scene logo = loadScene(course("scene6_18_6.837_logo.txt"));
+  ASSERT_EQ(logo.solidTextures.size(), 3u);
+  const SolidTexture& checker = logo.solidTextures[logo.materials[7].solidTexture];
+  EXPECT_EQ(checker.kind, SolidKind::Checkerboard);
+  EXPECT_EQ(logo.solidTextures[logo.materials[checker.materials[0]].solidTexture].kind, SolidKind::Wood);
+  EXPECT_EQ(logo.solidTextures[logo.materials[checker.materials[1]].solidTexture].kind, SolidKind::Wood);
+  TempDir dir;
+  const auto bad = [&](const std::string& body, const char* expected) {
+    const std::string path = dir.write("bad.txt", "Materials { numMaterials 2 PhongMaterial { } " + body + " }\n");
+    try {
+      loadScene(path);
+      ADD_FAILURE() << body;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+      EXPECT_EQ(std::string(e.what()).rfind(path + ":1:", 0), 0u) << e.what();
+    }
+  };
+  bad("Checkerboard { materialIndex 0 materialIndex 1 }", "does not name a material defined before it");
+  bad("Noise { materialIndex 0 materialIndex 0 octaves 99 }", "octaves 99 out of range");
+  bad("Marble { materialIndex 0 materialIndex 0 materialIndex 0 }", "more than two materialIndex");
+  bad("Wood { materialIndex 0 }", "needs two materialIndex");
+  bad("Checkerboard { materialIndex 0 materialIndex 0 octaves 2 }", "unknown Checkerboard field 'octaves'");
 }
 
 TEST(ImportCourse, AllEightyFiveSeedScenesParse) {

@@ -415,7 +415,7 @@ std::string describeFill(const FillReport& r) {
   if (r.openEdges > 0 && r.leakyMethod) out << "; ";
   if (r.leakyMethod) out << "method center leaves gaps in surfaces";
   out << "), " << r.solidCells << " solid cells (" << r.enclosedCells << " enclosed, " << r.windingCells
-      << " by winding number of " << r.windingQueries << " runs)";
+      << " by winding number, " << r.windingQueries << " evaluations)";
   return out.str();
 }
 

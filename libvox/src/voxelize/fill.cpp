@@ -379,6 +379,19 @@ FillReport fillSolid(Grid& grid, const Scene& scene, const FillOptions& options)
     const uint64_t outside = uf.find(0);
     for (uint64_t g = 0; g < table.gaps.size(); ++g) enclosed[g] = uf.find(g + 1) != outside;
   }
+  grid.solidRuns.clear();
+  if (report.rule == FillRule::Enclosed) {
+    // The enclosed gaps are the runs, already sorted and never adjacent (occupied cells or a row end between
+    // them): no per-run scratch needed.
+    for (uint64_t g = 0; g < table.gaps.size(); ++g)
+      if (enclosed[g]) {
+        grid.solidRuns.push_back(table.gaps[g]);
+        report.solidCells += table.gaps[g].count;
+      }
+    report.enclosedCells = report.solidCells;
+    if (options.progress) options.progress(1.0);
+    return report;
+  }
   std::vector<Piece> pieces(table.gaps.size() + 2 * table.row.size());
   report.windingQueries = decideRuns(grid, scene, table, enclosed, report.rule == FillRule::WindingNumber, options,
                                      pieces);

@@ -46,7 +46,10 @@ void buildNode(WindingTree& tree, BuildInput& in, std::vector<uint32_t>& order, 
   tree.nodes.emplace_back();
   if (count > kLeafSize) {
     Vec3 lo = in.centroid[order[first]], hi = lo;
-    for (uint32_t t = first; t < first + count; ++t) lo = minVec(lo, in.centroid[order[t]]), hi = maxVec(hi, in.centroid[order[t]]);
+    for (uint32_t t = first; t < first + count; ++t) {
+      lo = minVec(lo, in.centroid[order[t]]);
+      hi = maxVec(hi, in.centroid[order[t]]);
+    }
     const Vec3 ext = hi - lo;
     const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
     const uint32_t half = count / 2;

@@ -248,8 +248,11 @@ TEST(RenderModes, DepthNormalsCountShade) {
   EXPECT_GE(st.countMax, 1.0);
   EXPECT_EQ(count.channels, 3u);
 
-  // Shade without lights: the headlight straight down the view gives diffuse 1 at the centre, background outside.
+  // Shade without lights, from below (the camera of the normals check): the square shows its back, black without
+  // shadeBack as in the course; with it the headlight straight down the view gives diffuse 1 at the centre.
   ro.mode = RenderMode::Shade;
+  EXPECT_FLOAT_EQ(render(scene, grid, AccelKind::Grid, ro).at(4, 4)[0], 0.0f);
+  ro.shadeBack = true;
   const Image shade = render(scene, grid, AccelKind::Grid, ro);
   EXPECT_FLOAT_EQ(shade.at(4, 4)[0], 1.0f);
   EXPECT_FLOAT_EQ(shade.at(0, 0)[2], 0.3f);

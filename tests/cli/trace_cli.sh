@@ -111,7 +111,7 @@ grep -q "must be finite" "$WORK/err.txt" || fail "NaN eye: message does not say 
 expect 1 "unknown image format" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.xyz" -q
 expect 1 "negative weight" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.png" --weight -1 -q
 expect 1 "NaN weight" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.png" --weight nan -q
-expect 1 "bounces 1000" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.png" --bounces 1000 -q
+expect 1 "bounces 11" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.png" --bounces 11 -q
 expect 1 "unknown filter" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.png" --filter sinc 1 -q
 expect 1 "filter radius 0" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.png" --filter box 0 -q
 expect 1 "filter radius not a number" -- "$TRACE" "$WORK/s.vgrid" -o "$WORK/outs/a.png" --filter tent x -q

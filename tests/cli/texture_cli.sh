@@ -34,7 +34,8 @@ print(int(100 * sum(r > 230 and 150 < g < 240 and b < 40 for r, g, b in faces) /
 PY
 )
 [ "${yellow:-0}" -ge 80 ] || fail "only ${yellow:-0}% of the Duck's faces are yellow"
-"$export_tool" "$tmp/duck.vgrid" -o "$tmp/duck.obj" --faces merged --color material --quiet || fail "export OBJ: exit $?"
+"$export_tool" "$tmp/duck.vgrid" -o "$tmp/duck.obj" --faces merged --color material --quiet ||
+  fail "export OBJ: exit $?"
 grep -q '^usemtl vox_ff' "$tmp/duck.obj" || fail "OBJ without a yellow-ish material"
 
 # A truncated texture image: bad input, one line naming the scene file and the image.

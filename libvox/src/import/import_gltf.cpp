@@ -189,10 +189,11 @@ class GltfReader {
       failHere("texture ", index, ": image ", t.source, " does not exist (", model_.images.size(), " images)");
     const tinygltf::Image& image = model_.images[size_t(t.source)];
     const std::string where = path_ + ": image " + std::to_string(t.source);
-    const std::string name = image.uri.rfind("data:", 0) == 0 ? "image " + std::to_string(t.source)
-                             : !image.uri.empty()              ? image.uri
-                                                               : (image.name.empty() ? "image " + std::to_string(t.source) : image.name);
-    Texture texture = decodeTexture(imageBytes(t.source), image.uri.rfind("data:", 0) == 0 ? "" : name, where);
+    const bool dataUri = image.uri.rfind("data:", 0) == 0;
+    std::string name = "image " + std::to_string(t.source);
+    if (!dataUri && !image.uri.empty()) name = image.uri;
+    if (image.uri.empty() && !image.name.empty()) name = image.name;
+    Texture texture = decodeTexture(imageBytes(t.source), dataUri ? "" : name, where);
     texture.name = name;
     if (t.sampler >= 0) {
       if (size_t(t.sampler) >= model_.samplers.size())

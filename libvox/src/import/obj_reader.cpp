@@ -133,12 +133,14 @@ class ObjParser {
       vertex(words, line);
     } else if (keyword == "f") {
       face(words, line);
+    } else if (keyword == "vt") {
+      texcoord(words, line);
     } else if (keyword == "usemtl") {
       useMaterial(words.name(), line);
     } else if (keyword == "mtllib") {
       for (std::string_view w = words.next(); !w.empty(); w = words.next())
         data_.libraries.push_back({std::string(w), line});
-    } else if (keyword == "vt" || keyword == "vn" || keyword == "vp" || keyword == "o" || keyword == "g" ||
+    } else if (keyword == "vn" || keyword == "vp" || keyword == "o" || keyword == "g" ||
                keyword == "s" || keyword == "l" || keyword == "p") {
       // Texture coordinates, normals, names, smoothing groups, lines and points: nothing a voxelizer uses.
     } else if (unknownCount_++ == 0) {
@@ -162,10 +164,41 @@ class ObjParser {
     data_.vertices.push_back({xyz[0], xyz[1], xyz[2]});
   }
 
-  // The 0-based vertex index of one face corner `a`, `a/t`, `a//n` or `a/t/n`.
-  uint32_t faceIndex(std::string_view word, long long line) {
+  // `vt u [v [w]]`: u and v kept exactly as written.
+  void texcoord(Words& words, long long line) {
+    double uvw[3] = {0, 0, 0};
+    int n = 0;
+    for (std::string_view w = words.next(); !w.empty(); w = words.next()) {
+      if (n == 3) failAt(line, "vt takes at most 3 numbers");
+      if (!parseNumber(w, uvw[n++])) failAt(line, "bad number ", quotedWord(w));
+    }
+    if (n == 0) failAt(line, "vt needs a number");
+    data_.texcoords.push_back({uvw[0], uvw[1]});
+  }
+
+  // The 0-based texture coordinate index written `t` in a face corner, or kNoObjTexcoord when empty.
+  uint32_t texcoordIndex(std::string_view t, std::string_view word, long long line) {
+    if (t.empty()) return kNoObjTexcoord;
+    long long i = 0;
+    const IntegerStatus status = parseInteger(t, i);
+    if (status == IntegerStatus::Bad) failAt(line, "bad face index ", quotedWord(word));
+    const long long seen = static_cast<long long>(data_.texcoords.size());
+    const long long zeroBased = i > 0 ? i - 1 : seen + i;
+    // Judged at the end: a file without any `vt` has its texture indices ignored, as they always were.
+    if (status == IntegerStatus::TooLarge || i == 0 || zeroBased < 0 ||
+        zeroBased >= static_cast<long long>(UINT32_MAX)) {
+      forwardTex_.push_back({kNoObjTexcoord, line, i});
+      return 0;
+    }
+    if (zeroBased >= seen) forwardTex_.push_back({static_cast<uint32_t>(zeroBased), line, i});
+    return static_cast<uint32_t>(zeroBased);
+  }
+
+  // The 0-based vertex index of one face corner `a`, `a/t`, `a//n` or `a/t/n`; `tex` gets t's index.
+  uint32_t faceIndex(std::string_view word, long long line, uint32_t& tex) {
     const size_t slash = word.find('/');
     const std::string_view head = word.substr(0, slash);
+    tex = kNoObjTexcoord;
     if (slash != std::string_view::npos) {
       std::string_view tail = word.substr(slash + 1);
       for (int part = 0; part < 2; ++part) {
@@ -174,6 +207,7 @@ class ObjParser {
         long long ignored = 0;
         if (!index.empty() && parseInteger(index, ignored) == IntegerStatus::Bad)
           failAt(line, "bad face index ", quotedWord(word));
+        if (part == 0) tex = texcoordIndex(index, word, line);
         if (next == std::string_view::npos) break;
         if (part == 1) failAt(line, "bad face index ", quotedWord(word));
         tail = tail.substr(next + 1);
@@ -195,11 +229,25 @@ class ObjParser {
 
   void face(Words& words, long long line) {
     polygon_.clear();
-    for (std::string_view w = words.next(); !w.empty(); w = words.next()) polygon_.push_back(faceIndex(w, line));
+    polygonTex_.clear();
+    bool textured = true;
+    for (std::string_view w = words.next(); !w.empty(); w = words.next()) {
+      uint32_t tex = kNoObjTexcoord;
+      polygon_.push_back(faceIndex(w, line, tex));
+      polygonTex_.push_back(tex);
+      textured &= tex != kNoObjTexcoord;
+    }
     if (polygon_.size() < 3) failAt(line, "face needs at least 3 vertices");
     for (size_t k = 1; k + 1 < polygon_.size(); ++k) {
       data_.triangles.push_back({polygon_[0], polygon_[k], polygon_[k + 1]});
       data_.triangleMaterial.push_back(currentMaterial_);
+      if (textured) {
+        // Texture coordinates appear with the first face that has them; earlier faces get none.
+        data_.triangleTexcoords.resize(data_.triangles.size() - 1, {kNoObjTexcoord, kNoObjTexcoord, kNoObjTexcoord});
+        data_.triangleTexcoords.push_back({polygonTex_[0], polygonTex_[k], polygonTex_[k + 1]});
+      } else if (!data_.triangleTexcoords.empty()) {
+        data_.triangleTexcoords.push_back({kNoObjTexcoord, kNoObjTexcoord, kNoObjTexcoord});
+      }
     }
   }
 
@@ -215,10 +263,15 @@ class ObjParser {
   }
 
   // Positive indices may name vertices defined further down; they are checked once all vertices are known.
-  void checkForwardIndices() const {
+  void checkForwardIndices() {
     const size_t count = data_.vertices.size();
     for (const ForwardIndex& f : forward_)
       if (f.zeroBased >= count) failAt(f.line, "face index ", f.written, " out of range (", count, " vertices)");
+    if (data_.texcoords.empty()) data_.triangleTexcoords.clear();
+    for (const ForwardIndex& f : forwardTex_)
+      if (!data_.texcoords.empty() && f.zeroBased >= data_.texcoords.size())
+        failAt(f.line, "texture coordinate index ", f.written, " out of range (", data_.texcoords.size(),
+               " texture coordinates)");
   }
 
   struct ForwardIndex {
@@ -232,6 +285,8 @@ class ObjParser {
   ObjData data_;
   std::vector<uint32_t> polygon_;  // the corners of the face being read
   std::vector<ForwardIndex> forward_;
+  std::vector<uint32_t> polygonTex_;  // the corners' texture coordinate indices
+  std::vector<ForwardIndex> forwardTex_;
   std::unordered_map<std::string, uint32_t> materialIds_;
   uint32_t currentMaterial_ = kNoObjMaterial;
   size_t unknownCount_ = 0;
@@ -287,8 +342,57 @@ std::string readTextFile(const std::string& path, const char* what, size_t maxBy
 
 ObjData parseObj(std::string_view text, const std::string& path) { return ObjParser(text, path).run(); }
 
-std::vector<Material> parseMtl(std::string_view text, const std::string& path, std::vector<std::string>& warnings) {
+// `map_Kd [options] FILE`: the options of the MTL specification skipped with their arguments.
+MtlDiffuseMap readDiffuseMap(Words& words, const std::string& path, long long line,
+                             std::vector<std::string>& warnings) {
+  MtlDiffuseMap map;
+  map.line = line;
+  auto where = [&] { return path + ":" + std::to_string(line) + ": map_Kd"; };
+  while (true) {
+    Words peek = words;
+    const std::string_view option = peek.next();
+    if (option.size() < 2 || option[0] != '-') break;
+    words = peek;
+    int args = 1;
+    if (option == "-mm") args = 2;
+    if (option == "-o" || option == "-s" || option == "-t") {
+      // One to three numbers; anything but the default (0 offset, 1 scale, 0 turbulence) changes the mapping.
+      const double neutral = option == "-s" ? 1 : 0;
+      bool ignored = false;
+      for (int k = 0; k < 3; ++k) {
+        Words again = words;
+        const std::string_view w = again.next();
+        double v = 0;
+        if (w.empty() || !parseNumber(w, v)) break;
+        words = again;
+        ignored |= v != neutral;
+      }
+      if (ignored) warnings.push_back(where() + " option " + std::string(option) + " is ignored");
+      continue;
+    }
+    const bool known = option == "-blendu" || option == "-blendv" || option == "-cc" || option == "-clamp" ||
+                       option == "-bm" || option == "-boost" || option == "-texres" || option == "-imfchan" ||
+                       option == "-mm" || option == "-type";
+    if (!known) {
+      warnings.push_back(where() + " unknown option " + quotedWord(option) + " skipped");
+      continue;
+    }
+    for (int k = 0; k < args; ++k) {
+      const std::string_view value = words.next();
+      if (value.empty()) fail<InputError>(where(), " option ", std::string(option), " needs a value");
+      if (option == "-clamp") map.clamp = value == "on";
+    }
+  }
+  map.file = std::string(words.name());
+  if (map.file.empty()) fail<InputError>(where(), " needs a file name");
+  return map;
+}
+
+std::vector<Material> parseMtl(std::string_view text, const std::string& path, std::vector<std::string>& warnings,
+                               std::vector<MtlDiffuseMap>* maps) {
   std::vector<Material> out;
+  std::vector<bool> kdGiven;
+  const size_t firstMap = maps ? maps->size() : 0;
   LineReader lines(text);
   std::string_view line;
   long long number = 0;
@@ -304,8 +408,16 @@ std::vector<Material> parseMtl(std::string_view text, const std::string& path, s
       fresh.name = std::string(name);
       fresh.diffuse = {0, 0, 0};
       out.push_back(fresh);
+      kdGiven.push_back(false);
     } else if (keyword == "Kd") {
       m.diffuse = readColour(words, keyword, path, number);
+      if (!out.empty()) kdGiven.back() = true;
+    } else if (keyword == "map_Kd") {
+      MtlDiffuseMap map = readDiffuseMap(words, path, number, warnings);
+      if (maps && !out.empty()) {
+        map.material = out.size() - 1;
+        maps->push_back(std::move(map));
+      }
     } else if (keyword == "Ks") {
       m.specular = readColour(words, keyword, path, number);
     } else if (keyword == "Ns") {
@@ -319,8 +431,11 @@ std::vector<Material> parseMtl(std::string_view text, const std::string& path, s
       else
         m.indexOfRefraction = ior;
     }
-    // Ka, Ke, d, Tr, illum and texture maps carry nothing the tools use.
+    // Ka, Ke, d, Tr, illum and other texture maps carry nothing the tools use.
   }
+  if (maps)
+    for (size_t k = firstMap; k < maps->size(); ++k)
+      if (!kdGiven[(*maps)[k].material]) out[(*maps)[k].material].diffuse = {1, 1, 1};
   return out;
 }
 

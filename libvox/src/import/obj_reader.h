@@ -5,12 +5,16 @@
 //
 // OBJ statements read: `v x y z [more numbers]`, `f a b c ...` (any polygon size, fan-triangulated in linear time;
 // forms a, a/t, a//n, a/t/n use the vertex index a; negative indices count back from the vertices read so far;
-// positive ones may name vertices defined later in the file), `usemtl NAME`, `mtllib FILE...`. Skipped: `vt`, `vn`,
+// positive ones may name vertices defined later in the file), `vt u [v [w]]` (kept as written, v upwards) with the
+// face forms a/t and a/t/n (a face's texture coordinates are kept when every corner has one), `usemtl NAME`,
+// `mtllib FILE...`. Skipped: `vn`,
 // `vp`, `o`, `g`, `s`, `l`, `p`, and any other keyword (counted in one warning). A trailing backslash joins the next
 // line; `#` at the start of a word ends the line; CRLF line ends are accepted.
 //
 // MTL statements read: `newmtl NAME`, `Kd`, `Ks` (one or three numbers), `Ns` (>= 0), `Ni` (> 0; `Ni 0`, which
-// exporters write for "unset", keeps 1 with a warning). Other statements are skipped.
+// exporters write for "unset", keeps 1 with a warning), `map_Kd [options] FILE` (options skipped with their
+// arguments; `-clamp on` kept; `-o`, `-s`, `-t` other than their defaults warned as ignored). Other statements are
+// skipped.
 #pragma once
 
 #include <array>
@@ -30,6 +34,7 @@ constexpr size_t kMaxObjFileBytes = size_t{4} << 30;
 constexpr size_t kMaxMtlFileBytes = size_t{64} << 20;
 
 constexpr uint32_t kNoObjMaterial = UINT32_MAX;
+constexpr uint32_t kNoObjTexcoord = UINT32_MAX;
 
 struct ObjLibrary {
   std::string name;  // as written after `mtllib`
@@ -45,6 +50,10 @@ struct ObjData {
   std::vector<std::string> materialNames;  // `usemtl` names, in order of first use
   std::vector<long long> materialLines;        // the line of each name's first `usemtl`
   std::vector<ObjLibrary> libraries;       // every `mtllib` file name, in file order
+  std::vector<TexCoord> texcoords;         // `vt` as written (u, v with v upwards, OBJ's convention)
+  // Empty when no face has texture coordinates; else one entry per triangle: indices into `texcoords`, all in
+  // range, or kNoObjTexcoord (all three) for a face without them.
+  std::vector<std::array<uint32_t, 3>> triangleTexcoords;
   std::vector<std::string> warnings;
 };
 
@@ -58,9 +67,20 @@ std::string readTextFile(const std::string& path, const char* what, size_t maxBy
 // Parses OBJ text; `path` only names the file in messages. Throws InputError "path:line: ...".
 ObjData parseObj(std::string_view text, const std::string& path);
 
+// A `map_Kd` of material `material` (an index into parseMtl's result): the file as written, its line, `-clamp on`.
+struct MtlDiffuseMap {
+  size_t material = 0;
+  std::string file;
+  long long line = 0;
+  bool clamp = false;
+};
+
 // Parses MTL text into materials in file order (name, diffuse <- Kd, specular <- Ks, exponent <- Ns,
 // indexOfRefraction <- Ni; a material starts with diffuse and specular black, exponent 1, index 1).
-// Remarks (such as `Ni 0`) are appended to `warnings`. Throws InputError "path:line: ...".
-std::vector<Material> parseMtl(std::string_view text, const std::string& path, std::vector<std::string>& warnings);
+// Remarks (such as `Ni 0`) are appended to `warnings`. `map_Kd` statements are appended to `maps` when given (a
+// material with `map_Kd` and no `Kd` gets diffuse white, so that the texture shows unchanged). Throws InputError
+// "path:line: ...".
+std::vector<Material> parseMtl(std::string_view text, const std::string& path, std::vector<std::string>& warnings,
+                               std::vector<MtlDiffuseMap>* maps = nullptr);
 
 }  // namespace vox

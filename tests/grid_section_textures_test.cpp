@@ -33,13 +33,12 @@ Scene texturedScene() {
   scene.textures.push_back(t);
   scene.triangles.push_back({{Vec3{0, 0, 0}, Vec3{1, 0, 0}, Vec3{0, 1, 0}}, 1});
   scene.triangles.push_back({{Vec3{0, 0, 1}, Vec3{1, 0, 1}, Vec3{0, 1, 1}}, 0});
-  scene.triangleUVs.push_back(
-      {TexCoord{0.1, 1.0 / 3}, TexCoord{-2.5, 1e300}, TexCoord{5e-324, -0.0}});
+  scene.triangleUVs.push_back({TexCoord{0.1, 1.0 / 3}, TexCoord{-2.5, 1e300}, TexCoord{5e-324, -0.0}});
   scene.triangleUVs.push_back({});
   return scene;
 }
 
-Grid gridOf(const Scene &scene) {
+Grid gridOf(const Scene& scene) {
   VoxelizeOptions options;
   options.dims = std::array<uint32_t, 3>{2, 2, 2};
   return voxelizeScene(scene, options);
@@ -47,35 +46,32 @@ Grid gridOf(const Scene &scene) {
 
 // `bytes` with its header checksum recomputed after a patch.
 std::string resealed(std::string bytes) {
-  const uint64_t sum =
-      gridChecksum(bytes.data() + kHeader, bytes.size() - kHeader);
+  const uint64_t sum = gridChecksum(bytes.data() + kHeader, bytes.size() - kHeader);
   std::memcpy(bytes.data() + 24, &sum, 8);
   return bytes;
 }
 
 template <typename T>
-std::string patched(const std::string &bytes, size_t at, T value) {
+std::string patched(const std::string& bytes, size_t at, T value) {
   std::string out = bytes;
   std::memcpy(out.data() + at, &value, sizeof value);
   return resealed(out);
 }
 
-void expectRefused(const std::string &bytes, const std::string &what) {
+void expectRefused(const std::string& bytes, const std::string& what) {
   try {
     decodeGridFile(bytes, "t.vgrid");
     ADD_FAILURE() << what << ": accepted";
-  } catch (const InputError &e) {
-    EXPECT_EQ(std::string(e.what()).rfind("t.vgrid: ", 0), 0u)
-        << what << ": " << e.what();
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("t.vgrid: ", 0), 0u) << what << ": " << e.what();
   }
 }
 
 TEST(GridSectionTextures, RoundTripsBitForBit) {
   const Scene scene = texturedScene();
-  const GridFile back =
-      decodeGridFile(encodeGridFile(scene, gridOf(scene)), "t.vgrid");
+  const GridFile back = decodeGridFile(encodeGridFile(scene, gridOf(scene)), "t.vgrid");
   ASSERT_EQ(back.scene.textures.size(), 1u);
-  const Texture &t = back.scene.textures[0];
+  const Texture& t = back.scene.textures[0];
   EXPECT_EQ(t.name, "TEXNAME");
   EXPECT_EQ(t.width, 2u);
   EXPECT_EQ(t.height, 1u);
@@ -87,9 +83,7 @@ TEST(GridSectionTextures, RoundTripsBitForBit) {
   ASSERT_EQ(back.scene.triangleUVs.size(), 2u);
   for (size_t i = 0; i < 2; ++i)
     for (size_t k = 0; k < 3; ++k) {
-      EXPECT_EQ(std::memcmp(&back.scene.triangleUVs[i][k],
-                            &scene.triangleUVs[i][k], sizeof(TexCoord)),
-                0);
+      EXPECT_EQ(std::memcmp(&back.scene.triangleUVs[i][k], &scene.triangleUVs[i][k], sizeof(TexCoord)), 0);
     }
 }
 
@@ -114,18 +108,15 @@ TEST(GridSectionTextures, EveryFieldIsChecked) {
   const size_t name = good.find("TEXNAME");
   ASSERT_NE(name, std::string::npos);
   const size_t body = name - 4 - 8;
-  const size_t w = name + 7, h = w + 4, wrapU = h + 4, wrapV = wrapU + 1,
-               texels = wrapV + 1;
-  const size_t pairs = texels + 8 + 6, material = pairs + 8,
-               texture = material + 4, uvCount = texture + 4;
+  const size_t w = name + 7, h = w + 4, wrapU = h + 4, wrapV = wrapU + 1, texels = wrapV + 1;
+  const size_t pairs = texels + 8 + 6, material = pairs + 8, texture = material + 4, uvCount = texture + 4;
   const size_t firstUv = uvCount + 8;
   ASSERT_EQ(firstUv + 2 * 6 * 8, good.size());
   EXPECT_NO_THROW(decodeGridFile(resealed(good), "t.vgrid"));
 
   expectRefused(patched(good, body, uint64_t(0)), "no textures");
   expectRefused(patched(good, body, uint64_t(2)), "two textures");
-  expectRefused(patched(good, body, std::numeric_limits<uint64_t>::max()),
-                "absurd texture count");
+  expectRefused(patched(good, body, std::numeric_limits<uint64_t>::max()), "absurd texture count");
   expectRefused(patched(good, w, uint32_t(0)), "zero width");
   expectRefused(patched(good, w, uint32_t(3)), "width not matching the texels");
   expectRefused(patched(good, h, uint32_t(kMaxTextureSide + 1)), "too tall");
@@ -133,19 +124,13 @@ TEST(GridSectionTextures, EveryFieldIsChecked) {
   expectRefused(patched(good, wrapV, uint8_t(255)), "unknown wrap");
   expectRefused(patched(good, texels, uint64_t(5)), "texel count");
   expectRefused(patched(good, texels, uint64_t(1) << 60), "absurd texel count");
-  expectRefused(patched(good, pairs, uint64_t(2)),
-                "material pairs past the body");
+  expectRefused(patched(good, pairs, uint64_t(2)), "material pairs past the body");
   expectRefused(patched(good, material, uint32_t(2)), "material out of range");
   expectRefused(patched(good, texture, uint32_t(1)), "texture out of range");
-  expectRefused(patched(good, uvCount, uint64_t(1)),
-                "coordinates not one per triangle");
-  expectRefused(patched(good, uvCount, uint64_t(3)),
-                "coordinates past the body");
-  expectRefused(
-      patched(good, firstUv + 8, std::numeric_limits<double>::quiet_NaN()),
-      "NaN coordinate");
-  expectRefused(patched(good, firstUv, std::numeric_limits<double>::infinity()),
-                "infinite coordinate");
+  expectRefused(patched(good, uvCount, uint64_t(1)), "coordinates not one per triangle");
+  expectRefused(patched(good, uvCount, uint64_t(3)), "coordinates past the body");
+  expectRefused(patched(good, firstUv + 8, std::numeric_limits<double>::quiet_NaN()), "NaN coordinate");
+  expectRefused(patched(good, firstUv, std::numeric_limits<double>::infinity()), "infinite coordinate");
   // Cut anywhere inside the section (header and checksum made consistent):
   // refused, never a crash. (Cut right before its tag, the file simply has no
   // section.)
@@ -157,5 +142,5 @@ TEST(GridSectionTextures, EveryFieldIsChecked) {
   }
 }
 
-} // namespace
-} // namespace vox
+}  // namespace
+}  // namespace vox

@@ -24,31 +24,28 @@ namespace {
 
 using testing::ScratchDir;
 
-std::string seed(const std::string &rel) {
+std::string seed(const std::string& rel) {
   return std::string(VOX_SEED_DIR) + "/" + rel;
 }
 
-std::string readAll(const std::string &path) {
+std::string readAll(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
 }
 
-void writeAll(const std::string &path, const std::string &bytes) {
+void writeAll(const std::string& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary) << bytes;
 }
 
-std::string base64(const std::string &in) {
-  static const char *k =
-      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+std::string base64(const std::string& in) {
+  static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
   for (size_t i = 0; i < in.size(); i += 3) {
     uint32_t n = uint8_t(in[i]) << 16;
-    if (i + 1 < in.size())
-      n |= uint8_t(in[i + 1]) << 8;
-    if (i + 2 < in.size())
-      n |= uint8_t(in[i + 2]);
+    if (i + 1 < in.size()) n |= uint8_t(in[i + 1]) << 8;
+    if (i + 2 < in.size()) n |= uint8_t(in[i + 2]);
     out += k[(n >> 18) & 63];
     out += k[(n >> 12) & 63];
     out += i + 1 < in.size() ? k[(n >> 6) & 63] : '=';
@@ -59,8 +56,7 @@ std::string base64(const std::string &in) {
 
 // Writes `pixels` (w * h * channels bytes, or 16-bit values when `format` is
 // UINT16) as an image file.
-void writeImage(const std::string &path, int w, int h, int channels,
-                const void *pixels,
+void writeImage(const std::string& path, int w, int h, int channels, const void* pixels,
                 OIIO::TypeDesc format = OIIO::TypeDesc::UINT8) {
   auto out = OIIO::ImageOutput::create(path);
   ASSERT_TRUE(out) << path;
@@ -73,14 +69,12 @@ void writeImage(const std::string &path, int w, int h, int channels,
 // in a 12x2 texture: block f is texels 2f and 2f+1 of both rows. Texture
 // coordinates stay between the block's texel centres, so bilinear sampling
 // never leaves the block and each face's voxels get its colour exactly.
-constexpr uint8_t kFace[6][3] = {{255, 0, 0},   {0, 255, 0},   {0, 0, 255},
-                                 {255, 255, 0}, {255, 0, 255}, {200, 100, 50}};
+constexpr uint8_t kFace[6][3] = {{255, 0, 0}, {0, 255, 0}, {0, 0, 255}, {255, 255, 0}, {255, 0, 255}, {200, 100, 50}};
 
-std::string cubePng(const ScratchDir &dir) {
+std::string cubePng(const ScratchDir& dir) {
   std::vector<uint8_t> px(12 * 2 * 3);
   for (int y = 0; y < 2; ++y)
-    for (int x = 0; x < 12; ++x)
-      std::memcpy(&px[(y * 12 + x) * 3], kFace[x / 2], 3);
+    for (int x = 0; x < 12; ++x) std::memcpy(&px[(y * 12 + x) * 3], kFace[x / 2], 3);
   writeImage(dir.file("cube.png"), 12, 2, 3, px.data());
   return readAll(dir.file("cube.png"));
 }
@@ -95,7 +89,7 @@ std::string cubeBuffer() {
     const float at = float(f % 2);
     const float u0 = (2 * f + 0.5f) / 12, u1 = (2 * f + 1.5f) / 12;
     const int corner[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-    for (const auto &k : corner) {
+    for (const auto& k : corner) {
       float p[3];
       p[a] = at;
       p[b] = float(k[0]);
@@ -105,21 +99,19 @@ std::string cubeBuffer() {
       uv.push_back(0.25f + 0.5f * float(k[1]));
     }
     const uint16_t base = uint16_t(4 * f);
-    for (int i : {0, 1, 2, 0, 2, 3})
-      idx.push_back(uint16_t(base + i));
+    for (int i : {0, 1, 2, 0, 2, 3}) idx.push_back(uint16_t(base + i));
   }
-  std::string bytes(reinterpret_cast<const char *>(pos.data()), pos.size() * 4);
-  bytes.append(reinterpret_cast<const char *>(uv.data()), uv.size() * 4);
-  bytes.append(reinterpret_cast<const char *>(idx.data()), idx.size() * 2);
+  std::string bytes(reinterpret_cast<const char*>(pos.data()), pos.size() * 4);
+  bytes.append(reinterpret_cast<const char*>(uv.data()), uv.size() * 4);
+  bytes.append(reinterpret_cast<const char*>(idx.data()), idx.size() * 2);
   return bytes;
 }
 
 // A .gltf of the cube; `bufferUri` and `imageUri` are written as given.
 // `samplerJson` replaces the sampler.
-std::string
-cubeGltf(const std::string &bufferUri, const std::string &imageUri,
-         const std::string &samplerJson = R"({"wrapS": 33071, "wrapT": 33648})",
-         const std::string &uvAttribute = R"(, "TEXCOORD_0": 1)") {
+std::string cubeGltf(const std::string& bufferUri, const std::string& imageUri,
+                     const std::string& samplerJson = R"({"wrapS": 33071, "wrapT": 33648})",
+                     const std::string& uvAttribute = R"(, "TEXCOORD_0": 1)") {
   std::ostringstream j;
   j << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
   "meshes": [{"primitives": [{"attributes": {"POSITION": 0)"
@@ -140,14 +132,13 @@ cubeGltf(const std::string &bufferUri, const std::string &imageUri,
   return j.str();
 }
 
-std::array<int, 3> bytesOf(const Vec3 &c) {
-  return {int(std::lround(c.x * 255)), int(std::lround(c.y * 255)),
-          int(std::lround(c.z * 255))};
+std::array<int, 3> bytesOf(const Vec3& c) {
+  return {int(std::lround(c.x * 255)), int(std::lround(c.y * 255)), int(std::lround(c.z * 255))};
 }
 
 // Voxelizes the cube at 4^3 and checks that every cell inside a face (not on
 // the cube's edges) has that face's colour, byte for byte.
-void expectCubeFaceColours(const Scene &scene) {
+void expectCubeFaceColours(const Scene& scene) {
   VoxelizeOptions options;
   options.dims = std::array<uint32_t, 3>{4, 4, 4};
   const Grid grid = voxelizeScene(scene, options);
@@ -157,18 +148,14 @@ void expectCubeFaceColours(const Scene &scene) {
     int face = -1, faces = 0;
     for (int a = 0; a < 3; ++a)
       for (int side = 0; side < 2; ++side)
-        if (ijk[a] == (side ? 3u : 0u))
-          face = 2 * a + side, ++faces;
-    if (faces != 1)
-      continue; // on an edge or corner of the cube: two faces mix
+        if (ijk[a] == (side ? 3u : 0u)) face = 2 * a + side, ++faces;
+    if (faces != 1) continue;  // on an edge or corner of the cube: two faces mix
     const auto got = bytesOf(cellMaterialColor(grid, scene, c));
-    EXPECT_EQ(got, (std::array<int, 3>{kFace[face][0], kFace[face][1],
-                                       kFace[face][2]}))
-        << "cell " << ijk[0] << " " << ijk[1] << " " << ijk[2] << " face "
-        << face;
+    EXPECT_EQ(got, (std::array<int, 3>{kFace[face][0], kFace[face][1], kFace[face][2]}))
+        << "cell " << ijk[0] << " " << ijk[1] << " " << ijk[2] << " face " << face;
     ++checked;
   }
-  EXPECT_EQ(checked, 6 * 4); // 2x2 interior cells per face
+  EXPECT_EQ(checked, 6 * 4);  // 2x2 interior cells per face
 }
 
 TEST(TextureImport, TexturedGltfCubeExternalFiles) {
@@ -186,9 +173,8 @@ TEST(TextureImport, TexturedGltfCubeExternalFiles) {
   EXPECT_EQ(scene.materials[0].diffuseTexture, 0u);
   ASSERT_EQ(scene.triangleUVs.size(), 12u);
   EXPECT_EQ(scene.triangleUVs[0][1].u,
-            double((0.5f + (1.5f - 0.5f)) / 12)); // floats read exactly
-  for (const std::string &w : scene.warnings)
-    ADD_FAILURE() << "warning: " << w;
+            double((0.5f + (1.5f - 0.5f)) / 12));  // floats read exactly
+  for (const std::string& w : scene.warnings) ADD_FAILURE() << "warning: " << w;
   expectCubeFaceColours(scene);
 }
 
@@ -196,10 +182,8 @@ TEST(TextureImport, TexturedGltfCubeEmbeddedDataUris) {
   ScratchDir dir("tex_cube_embedded");
   const std::string png = cubePng(dir);
   std::filesystem::remove(dir.file("cube.png"));
-  writeAll(
-      dir.file("cube.gltf"),
-      cubeGltf("data:application/octet-stream;base64," + base64(cubeBuffer()),
-               "data:image/png;base64," + base64(png)));
+  writeAll(dir.file("cube.gltf"), cubeGltf("data:application/octet-stream;base64," + base64(cubeBuffer()),
+                                           "data:image/png;base64," + base64(png)));
   const Scene scene = importGltf(dir.file("cube.gltf"));
   ASSERT_EQ(scene.textures.size(), 1u);
   expectCubeFaceColours(scene);
@@ -212,8 +196,7 @@ TEST(TextureImport, PrimitiveWithoutTexcoordsKeepsTheFactor) {
   writeAll(dir.file("cube.gltf"), cubeGltf("cube.bin", "cube.png", "{}", ""));
   const Scene scene = importGltf(dir.file("cube.gltf"));
   ASSERT_EQ(scene.warnings.size(), 1u);
-  EXPECT_NE(scene.warnings[0].find("no TEXCOORD_0"), std::string::npos)
-      << scene.warnings[0];
+  EXPECT_NE(scene.warnings[0].find("no TEXCOORD_0"), std::string::npos) << scene.warnings[0];
   const uint32_t m = scene.triangles[0].material;
   ASSERT_LT(m, scene.materials.size());
   EXPECT_EQ(scene.materials[m].diffuseTexture, kNoTexture);
@@ -229,12 +212,10 @@ TEST(TextureImport, BadTexturesAreErrorsNamingTheImage) {
   try {
     importGltf(dir.file("a.gltf"));
     FAIL() << "truncated PNG accepted";
-  } catch (const InputError &e) {
-    EXPECT_NE(std::string(e.what()).find("a.gltf: image 0"), std::string::npos)
-        << e.what();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("a.gltf: image 0"), std::string::npos) << e.what();
   }
-  writeAll(dir.file("b.gltf"),
-           cubeGltf("cube.bin", "cube.png", R"({"wrapS": 1234})"));
+  writeAll(dir.file("b.gltf"), cubeGltf("cube.bin", "cube.png", R"({"wrapS": 1234})"));
   EXPECT_THROW(importGltf(dir.file("b.gltf")), InputError);
   writeAll(dir.file("junk.png"), std::string(100, 'x'));
   writeAll(dir.file("c.gltf"), cubeGltf("cube.bin", "junk.png"));
@@ -243,8 +224,7 @@ TEST(TextureImport, BadTexturesAreErrorsNamingTheImage) {
 
 TEST(TextureImport, DecodeGreyAlphaSixteenBitAndFloat) {
   ScratchDir dir("tex_decode");
-  const uint8_t ga[4] = {10, 255, 200,
-                         0}; // grey + alpha: alpha dropped, grey spread
+  const uint8_t ga[4] = {10, 255, 200, 0};  // grey + alpha: alpha dropped, grey spread
   writeImage(dir.file("ga.png"), 2, 1, 2, ga);
   Texture t = decodeTexture(readAll(dir.file("ga.png")), "ga.png", "ga");
   EXPECT_EQ(t.rgb, (std::vector<uint8_t>{10, 10, 10, 200, 200, 200}));
@@ -252,7 +232,7 @@ TEST(TextureImport, DecodeGreyAlphaSixteenBitAndFloat) {
   writeImage(dir.file("d.png"), 1, 1, 3, deep, OIIO::TypeDesc::UINT16);
   t = decodeTexture(readAll(dir.file("d.png")), "d.png", "d");
   EXPECT_EQ(t.rgb, (std::vector<uint8_t>{255, 128, 0}));
-  const float lin[3] = {1.0f, 0.5f, 0.0f}; // linear light, encoded to sRGB
+  const float lin[3] = {1.0f, 0.5f, 0.0f};  // linear light, encoded to sRGB
   writeImage(dir.file("f.exr"), 1, 1, 3, lin, OIIO::TypeDesc::FLOAT);
   t = decodeTexture(readAll(dir.file("f.exr")), "f.exr", "f");
   EXPECT_EQ(t.rgb, (std::vector<uint8_t>{255, 188, 0}));
@@ -260,8 +240,7 @@ TEST(TextureImport, DecodeGreyAlphaSixteenBitAndFloat) {
   writeImage(dir.file("j.jpg"), 1, 1, 3, rgb);
   const std::string jpg = readAll(dir.file("j.jpg"));
   EXPECT_EQ(decodeTexture(jpg, "", "j").width, 1u);
-  EXPECT_THROW(decodeTexture(jpg.substr(0, jpg.size() / 2), "", "j"),
-               InputError);
+  EXPECT_THROW(decodeTexture(jpg.substr(0, jpg.size() / 2), "", "j"), InputError);
   EXPECT_THROW(decodeTexture("", "", "e"), InputError);
   EXPECT_THROW(decodeTexture("just text", "x.unknownext", "e"), InputError);
 }
@@ -273,9 +252,8 @@ TEST(TextureImport, TheDuckIsYellow) {
   const Scene glb = importGltf(seed("gltf/Duck/glTF-Binary/Duck.glb"));
   ASSERT_EQ(gltf.textures.size(), 1u);
   ASSERT_EQ(glb.textures.size(), 1u);
-  EXPECT_EQ(
-      gltf.textures[0].rgb,
-      glb.textures[0].rgb); // external file and GLB bufferView decode alike
+  EXPECT_EQ(gltf.textures[0].rgb,
+            glb.textures[0].rgb);  // external file and GLB bufferView decode alike
   ASSERT_EQ(gltf.triangleUVs.size(), gltf.triangles.size());
   VoxelizeOptions options;
   options.resolution = 24;
@@ -288,18 +266,15 @@ TEST(TextureImport, TheDuckIsYellow) {
     // colour.
     EXPECT_EQ(bytesOf(col), bytesOf(cellMaterialColor(grid, glb, c)));
   }
-  EXPECT_GT(double(yellow), 0.8 * double(grid.cellKeys.size()))
-      << yellow << " of " << grid.cellKeys.size();
+  EXPECT_GT(double(yellow), 0.8 * double(grid.cellKeys.size())) << yellow << " of " << grid.cellKeys.size();
 }
 
 // BoxTextured three ways: external PNG, data URI, GLB bufferView: the same
 // texels.
 TEST(TextureImport, BoxTexturedEveryImageSource) {
   const Scene a = importGltf(seed("gltf/BoxTextured/glTF/BoxTextured.gltf"));
-  const Scene b =
-      importGltf(seed("gltf/BoxTextured/glTF-Embedded/BoxTextured.gltf"));
-  const Scene c =
-      importGltf(seed("gltf/BoxTextured/glTF-Binary/BoxTextured.glb"));
+  const Scene b = importGltf(seed("gltf/BoxTextured/glTF-Embedded/BoxTextured.gltf"));
+  const Scene c = importGltf(seed("gltf/BoxTextured/glTF-Binary/BoxTextured.glb"));
   ASSERT_EQ(a.textures.size(), 1u);
   ASSERT_EQ(b.textures.size(), 1u);
   ASSERT_EQ(c.textures.size(), 1u);
@@ -312,33 +287,31 @@ TEST(TextureImport, BoxTexturedEveryImageSource) {
 // the quad.
 TEST(TextureImport, ObjMapKd) {
   ScratchDir dir("tex_obj");
-  const uint8_t px[6] = {255, 0, 0,
-                         0,   0, 255}; // 1x2: top row red, bottom row blue
+  const uint8_t px[6] = {255, 0, 0, 0, 0, 255};  // 1x2: top row red, bottom row blue
   writeImage(dir.file("tex.png"), 1, 2, 3, px);
-  writeAll(dir.file("q.mtl"), "newmtl t\nmap_Kd -clamp on -s 1 1 1 -bm 1 "
-                              "tex.png\nnewmtl gone\nKd 0 1 0\n"
-                              "map_Kd missing.png\n");
-  writeAll(
-      dir.file("q.obj"),
-      "mtllib q.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\n"
-      "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl t\nf 1/1 2/2 3/3 4/4\nf 1 2 5\n"
-      "usemtl gone\nf 2 3 5\n");
+  writeAll(dir.file("q.mtl"),
+           "newmtl t\nmap_Kd -clamp on -s 1 1 1 -bm 1 "
+           "tex.png\nnewmtl gone\nKd 0 1 0\n"
+           "map_Kd missing.png\n");
+  writeAll(dir.file("q.obj"),
+           "mtllib q.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\n"
+           "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl t\nf 1/1 2/2 3/3 4/4\nf 1 2 5\n"
+           "usemtl gone\nf 2 3 5\n");
   const Scene scene = importObj(dir.file("q.obj"));
   ASSERT_EQ(scene.textures.size(), 1u);
   EXPECT_EQ(scene.textures[0].wrapU, TextureWrap::ClampToEdge);
   EXPECT_EQ(scene.materials[0].diffuseTexture, 0u);
   EXPECT_EQ(scene.materials[0].diffuse.x,
-            1); // no Kd: white, so the texture shows unchanged
+            1);  // no Kd: white, so the texture shows unchanged
   EXPECT_EQ(scene.materials[1].diffuseTexture,
-            kNoTexture); // its image is missing: Kd stays
+            kNoTexture);  // its image is missing: Kd stays
   ASSERT_EQ(scene.triangleUVs.size(), 4u);
-  EXPECT_EQ(scene.triangleUVs[0][2].v, 1); // as written
+  EXPECT_EQ(scene.triangleUVs[0][2].v, 1);  // as written
   // The face without vt has an untextured copy of the material; both remarks
   // are warnings.
-  EXPECT_EQ(scene.materials[scene.triangles[2].material].diffuseTexture,
-            kNoTexture);
+  EXPECT_EQ(scene.materials[scene.triangles[2].material].diffuseTexture, kNoTexture);
   EXPECT_EQ(scene.warnings.size(), 2u);
-  Scene quad = scene; // only the textured quad
+  Scene quad = scene;  // only the textured quad
   quad.triangles.resize(2);
   quad.triangleUVs.resize(2);
   VoxelizeOptions options;
@@ -346,18 +319,16 @@ TEST(TextureImport, ObjMapKd) {
   options.dims = std::array<uint32_t, 3>{1, 2, 1};
   const Grid grid = voxelizeScene(quad, options);
   ASSERT_EQ(grid.cellKeys.size(), 2u);
-  const Vec3 bottom = cellMaterialColor(grid, quad, 0),
-             top = cellMaterialColor(grid, quad, 1);
+  const Vec3 bottom = cellMaterialColor(grid, quad, 0), top = cellMaterialColor(grid, quad, 1);
   EXPECT_GT(top.x, 0.9);
   EXPECT_LT(top.z, 0.7);
   EXPECT_GT(bottom.z, 0.9);
   EXPECT_LT(bottom.x, 0.7);
   // A texture outside the OBJ's folder is refused.
   writeAll(dir.file("e.mtl"), "newmtl t\nmap_Kd ../../etc/passwd\n");
-  writeAll(dir.file("e.obj"),
-           "mtllib e.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl t\nf 1 2 3\n");
+  writeAll(dir.file("e.obj"), "mtllib e.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl t\nf 1 2 3\n");
   EXPECT_THROW(importObj(dir.file("e.obj")), InputError);
 }
 
-} // namespace
-} // namespace vox
+}  // namespace
+}  // namespace vox

@@ -10,8 +10,7 @@
 namespace vox {
 namespace {
 
-Texture texture(uint32_t w, uint32_t h, std::vector<uint8_t> rgb,
-                TextureWrap wrap = TextureWrap::Repeat) {
+Texture texture(uint32_t w, uint32_t h, std::vector<uint8_t> rgb, TextureWrap wrap = TextureWrap::Repeat) {
   Texture t;
   t.width = w;
   t.height = h;
@@ -23,7 +22,7 @@ Texture texture(uint32_t w, uint32_t h, std::vector<uint8_t> rgb,
 TEST(Texture, SrgbRoundTripsEveryByte) {
   EXPECT_EQ(srgbToLinear(0), 0);
   EXPECT_EQ(srgbToLinear(255), 1);
-  EXPECT_NEAR(srgbToLinear(188), 0.5029, 1e-4); // the familiar "half grey"
+  EXPECT_NEAR(srgbToLinear(188), 0.5029, 1e-4);  // the familiar "half grey"
   for (int b = 0; b < 256; ++b) {
     EXPECT_EQ(std::lround(linearToSrgb(srgbToLinear(uint8_t(b))) * 255), b);
     if (b > 0) {
@@ -65,10 +64,8 @@ TEST(Texture, BilinearBetweenTexelCentresAndWrapModes) {
 
 TEST(Texture, RowsRunFromTheTop) {
   // Row 0 red, row 1 blue: v = 0.25 is red, v = 0.75 blue (glTF convention).
-  const Texture t =
-      texture(1, 2, {255, 0, 0, 0, 0, 255}, TextureWrap::ClampToEdge);
-  const Vec3 top = sampleTexture(t, {0.5, 0.25}),
-             bottom = sampleTexture(t, {0.5, 0.75});
+  const Texture t = texture(1, 2, {255, 0, 0, 0, 0, 255}, TextureWrap::ClampToEdge);
+  const Vec3 top = sampleTexture(t, {0.5, 0.25}), bottom = sampleTexture(t, {0.5, 0.75});
   EXPECT_EQ(top.x, 1);
   EXPECT_EQ(top.z, 0);
   EXPECT_EQ(bottom.x, 0);
@@ -81,7 +78,7 @@ TEST(Texture, ValidationNamesTheProblem) {
   scene.triangles.push_back({{Vec3{0, 0, 0}, Vec3{1, 0, 0}, Vec3{0, 1, 0}}, 0});
   EXPECT_NO_THROW(validateTextures(scene, "s"));
   scene.materials[0].diffuseTexture = 0;
-  EXPECT_THROW(validateTextures(scene, "s"), InputError); // no texture 0
+  EXPECT_THROW(validateTextures(scene, "s"), InputError);  // no texture 0
   scene.textures.push_back(texture(2, 1, {1, 2, 3, 4, 5, 6}));
   EXPECT_NO_THROW(validateTextures(scene, "s"));
   scene.textures[0].rgb.pop_back();
@@ -94,19 +91,16 @@ TEST(Texture, ValidationNamesTheProblem) {
   scene.textures[0].wrapV = TextureWrap::Repeat;
   scene.triangleUVs.resize(2);
   EXPECT_THROW(validateTextures(scene, "s"),
-               InputError); // not one per triangle
+               InputError);  // not one per triangle
   scene.triangleUVs.resize(1);
   scene.triangleUVs[0][2].v = std::numeric_limits<double>::infinity();
   try {
     validateScene(scene, "scene.gltf");
     FAIL() << "infinite texture coordinate accepted";
-  } catch (const InputError &e) {
-    EXPECT_NE(std::string(e.what()).find(
-                  "scene.gltf: triangle 0: texture coordinate"),
-              std::string::npos)
-        << e.what();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("scene.gltf: triangle 0: texture coordinate"), std::string::npos) << e.what();
   }
 }
 
-} // namespace
-} // namespace vox
+}  // namespace
+}  // namespace vox

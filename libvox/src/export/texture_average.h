@@ -21,9 +21,7 @@ struct TextureSum {
 
   // The average in linear light. Precondition: !empty().
   bool empty() const { return areaWeight == 0 && touchCount == 0; }
-  Vec3 average() const {
-    return areaWeight > 0 ? area / areaWeight : touch / touchCount;
-  }
+  Vec3 average() const { return areaWeight > 0 ? area / areaWeight : touch / touchCount; }
 };
 
 // Adds `texture` over the part of triangle `t` (texture coordinates `uv`)
@@ -33,8 +31,7 @@ struct TextureSum {
 // that coarse cells average over the texels they cover, not a few of them
 // (beyond 1024 texels a piece, at stratified pseudo-random points: noise, not
 // aliasing). Never throws.
-void addTextureOverBox(const Texture &texture, const std::array<Vec3, 3> &t,
-                       const std::array<TexCoord, 3> &uv, const Box &box,
-                       TextureSum &sum);
+void addTextureOverBox(const Texture& texture, const std::array<Vec3, 3>& t, const std::array<TexCoord, 3>& uv,
+                       const Box& box, TextureSum& sum);
 
-} // namespace vox
+}  // namespace vox

@@ -13,13 +13,13 @@
 
 namespace vox {
 
-bool hasTexturesSection(const Scene &scene, const Grid &) {
+bool hasTexturesSection(const Scene& scene, const Grid&) {
   return !scene.textures.empty();
 }
 
-void putTexturesSection(ByteWriter &w, const Scene &scene, const Grid &) {
+void putTexturesSection(ByteWriter& w, const Scene& scene, const Grid&) {
   w.put(uint64_t(scene.textures.size()));
-  for (const Texture &t : scene.textures) {
+  for (const Texture& t : scene.textures) {
     w.putString(t.name);
     w.put(t.width);
     w.put(t.height);
@@ -28,8 +28,7 @@ void putTexturesSection(ByteWriter &w, const Scene &scene, const Grid &) {
     w.putArray(t.rgb);
   }
   uint64_t textured = 0;
-  for (const Material &m : scene.materials)
-    textured += m.diffuseTexture != kNoTexture;
+  for (const Material& m : scene.materials) textured += m.diffuseTexture != kNoTexture;
   w.put(textured);
   for (size_t i = 0; i < scene.materials.size(); ++i)
     if (scene.materials[i].diffuseTexture != kNoTexture) {
@@ -37,8 +36,8 @@ void putTexturesSection(ByteWriter &w, const Scene &scene, const Grid &) {
       w.put(scene.materials[i].diffuseTexture);
     }
   w.put(uint64_t(scene.triangleUVs.size()));
-  for (const auto &uv : scene.triangleUVs)
-    for (const TexCoord &c : uv) {
+  for (const auto& uv : scene.triangleUVs)
+    for (const TexCoord& c : uv) {
       w.put(c.u);
       w.put(c.v);
     }
@@ -46,65 +45,57 @@ void putTexturesSection(ByteWriter &w, const Scene &scene, const Grid &) {
 
 namespace {
 
-TextureWrap getWrap(ByteReader &r) {
+TextureWrap getWrap(ByteReader& r) {
   const uint8_t w = r.get<uint8_t>();
-  if (w > uint8_t(TextureWrap::MirroredRepeat))
-    r.corrupt("unknown texture wrap mode " + std::to_string(w));
+  if (w > uint8_t(TextureWrap::MirroredRepeat)) r.corrupt("unknown texture wrap mode " + std::to_string(w));
   return TextureWrap(w);
 }
 
-Texture getTexture(ByteReader &r) {
+Texture getTexture(ByteReader& r) {
   Texture t;
   t.name = r.getString();
   t.width = r.get<uint32_t>();
   t.height = r.get<uint32_t>();
-  if (t.width == 0 || t.height == 0 || t.width > kMaxTextureSide ||
-      t.height > kMaxTextureSide)
-    r.corrupt("texture size " + std::to_string(t.width) + "x" +
-              std::to_string(t.height) + " out of range");
+  if (t.width == 0 || t.height == 0 || t.width > kMaxTextureSide || t.height > kMaxTextureSide)
+    r.corrupt("texture size " + std::to_string(t.width) + "x" + std::to_string(t.height) + " out of range");
   t.wrapU = getWrap(r);
   t.wrapV = getWrap(r);
   const size_t at = r.position();
-  t.rgb = r.getArray<uint8_t>(
-      "texel byte"); // its count is checked against the file before allocating
+  t.rgb = r.getArray<uint8_t>("texel byte");  // its count is checked against the file before allocating
   if (t.rgb.size() != uint64_t(t.width) * t.height * 3)
-    fail<InputError>(r.name(), ": byte ", at, ": ", t.rgb.size(),
-                     " texel bytes for a ", t.width, "x", t.height, " texture");
+    fail<InputError>(r.name(), ": byte ", at, ": ", t.rgb.size(), " texel bytes for a ", t.width, "x", t.height,
+                     " texture");
   return t;
 }
 
-} // namespace
+}  // namespace
 
-void getTexturesSection(ByteReader &r, Scene &scene, Grid &) {
+void getTexturesSection(ByteReader& r, Scene& scene, Grid&) {
   const uint64_t nTextures = r.getCount(4 + 4 + 4 + 2 + 8 + 3, "texture");
-  if (nTextures == 0)
-    r.corrupt("textures section without textures");
+  if (nTextures == 0) r.corrupt("textures section without textures");
   scene.textures.reserve(nTextures);
-  for (uint64_t i = 0; i < nTextures; ++i)
-    scene.textures.push_back(getTexture(r));
+  for (uint64_t i = 0; i < nTextures; ++i) scene.textures.push_back(getTexture(r));
   const uint64_t nTextured = r.getCount(8, "textured material");
   uint64_t previous = 0;
   for (uint64_t k = 0; k < nTextured; ++k) {
     const uint32_t m = r.get<uint32_t>();
     const uint32_t t = r.get<uint32_t>();
     if (m >= scene.materials.size() || (k > 0 && m <= previous))
-      r.corrupt("textured material " + std::to_string(m) +
-                " out of range or out of order");
-    if (t >= nTextures)
-      r.corrupt("material texture " + std::to_string(t) + " out of range");
+      r.corrupt("textured material " + std::to_string(m) + " out of range or out of order");
+    if (t >= nTextures) r.corrupt("material texture " + std::to_string(t) + " out of range");
     scene.materials[m].diffuseTexture = t;
     previous = m;
   }
   const uint64_t nUV = r.getCount(6 * 8, "texture coordinate");
   if (nUV != 0 && nUV != scene.triangles.size())
-    r.corrupt(std::to_string(nUV) + " triangles' texture coordinates for " +
-              std::to_string(scene.triangles.size()) + " triangles");
+    r.corrupt(std::to_string(nUV) + " triangles' texture coordinates for " + std::to_string(scene.triangles.size()) +
+              " triangles");
   scene.triangleUVs.resize(nUV);
-  for (auto &uv : scene.triangleUVs)
-    for (TexCoord &c : uv) {
+  for (auto& uv : scene.triangleUVs)
+    for (TexCoord& c : uv) {
       c.u = r.getFinite("texture coordinate");
       c.v = r.getFinite("texture coordinate");
     }
 }
 
-} // namespace vox
+}  // namespace vox

@@ -28,6 +28,6 @@ namespace vox {
 // white. Throws InputError when a primitive id or material index is out of
 // range (grids decoded from files are checked before; this guards the rest).
 // Reads only; safe to call from many threads at once.
-Vec3 cellMaterialColor(const Grid &grid, const Scene &scene, size_t cell);
+Vec3 cellMaterialColor(const Grid& grid, const Scene& scene, size_t cell);
 
-} // namespace vox
+}  // namespace vox

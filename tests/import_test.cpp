@@ -613,10 +613,13 @@ TEST(ImportGltf, DuckHasACamera) {
   EXPECT_EQ(loadScene(seed("gltf/Duck/glTF-Binary/Duck.glb")).triangles.size(), 4212u);
 }
 
-TEST(ImportGltf, BoxTexturedEmbeddedWarnsAboutTextures) {
+TEST(ImportGltf, BoxTexturedEmbeddedReadsItsTextureWithoutWarning) {
+  // Issue 11: the base colour texture is read (it used to be a warning and a flat factor).
   const Scene s = loadScene(seed("gltf/BoxTextured/glTF-Embedded/BoxTextured.gltf"));
   EXPECT_EQ(s.triangles.size(), 12u);
-  EXPECT_EQ(countWarnings(s, "texture"), 1u);
+  EXPECT_EQ(s.textures.size(), 1u);
+  EXPECT_EQ(s.triangleUVs.size(), s.triangles.size());
+  EXPECT_EQ(countWarnings(s, "texture"), 0u);
 }
 
 TEST(ImportGltf, CamerasTakesTheFirstCameraNode) {

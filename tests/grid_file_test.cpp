@@ -6,6 +6,7 @@
 #include <fstream>
 #include <random>
 
+#include "io/byte_codec.h"
 #include "test_util.h"
 #include "vox/trace/accel.h"
 #include "vox/core/error.h"
@@ -243,6 +244,28 @@ TEST(GridFile, BadSolidRunsAndUnknownSectionsAreRefused) {
   // A section header promising more bytes than remain.
   bytes.resize(bytes.size() - 2);
   EXPECT_THROW(decodeGridFile(resum(bytes), "tag.vgrid"), InputError);
+}
+
+TEST(GridFile, WrittenFileEqualsTheEncodingAcrossChunks) {
+  // writeGridFile streams the encoding three times (size, checksum, bytes) in chunks of ByteWriter::kChunkBytes
+  // with large arrays handed over whole; the file must be exactly encodeGridFile's bytes. A grid of several chunks,
+  // with solid runs and arrays straddling chunk boundaries at odd offsets.
+  Scene scene = sampleScene();
+  scene.materials[1].name = "odd length";  // shifts every later byte off the 8-byte word grid
+  VoxelizeOptions opt;
+  opt.dims = {61, 47, 33};
+  Grid grid = voxelizeScene(scene, opt);
+  for (uint64_t k = 5; k < grid.cellCount(); k += 3) appendSolidKey(grid.solidRuns, k);
+  const std::string expected = encodeGridFile(scene, grid);
+  ASSERT_GT(expected.size(), 3 * ByteWriter::kChunkBytes);
+  testing::ScratchDir dir("gridstream");
+  const std::string path = dir.file("s.vgrid");
+  writeGridFile(path, scene, grid);
+  std::ifstream in(path, std::ios::binary);
+  const std::string written((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(written.size(), expected.size());
+  EXPECT_TRUE(written == expected);
+  EXPECT_EQ(encodeGridFile(readGridFile(path).scene, readGridFile(path).grid), expected);
 }
 
 TEST(GridFile, NewerVersionAndMissingFile) {

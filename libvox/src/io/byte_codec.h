@@ -5,7 +5,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <vector>
 
@@ -14,13 +16,20 @@
 
 namespace vox {
 
+// Encodes values into bytes kept in memory (bytes()), or, when given a sink, hands them on in chunks of about
+// kChunkBytes, so that writing a large grid file never holds the whole file in memory.
 class ByteWriter {
  public:
+  using Sink = std::function<void(std::string_view)>;
+  static constexpr size_t kChunkBytes = size_t(1) << 16;
+
+  ByteWriter() = default;
+  explicit ByteWriter(Sink sink) : sink_(std::move(sink)) {}
+
   template <typename T>
   void put(const T& value) {
     static_assert(std::is_trivially_copyable_v<T>);
-    const char* p = reinterpret_cast<const char*>(&value);
-    out_.append(p, sizeof(T));
+    putBytes({reinterpret_cast<const char*>(&value), sizeof(T)});
   }
   void putVec(const Vec3& v) {
     put(v.x);
@@ -29,16 +38,33 @@ class ByteWriter {
   }
   void putString(const std::string& s) {
     put(uint32_t(s.size()));
-    out_.append(s);
+    putBytes(s);
   }
   template <typename T>
   void putArray(const std::vector<T>& values) {
+    static_assert(std::is_trivially_copyable_v<T>);
     put(uint64_t(values.size()));
-    out_.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+    putBytes({reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T)});
   }
+  void putBytes(std::string_view bytes) {
+    if (sink_ && bytes.size() >= kChunkBytes) {  // large arrays go straight to the sink, uncopied
+      finish();
+      sink_(bytes);
+      return;
+    }
+    out_.append(bytes);
+    if (sink_ && out_.size() >= kChunkBytes) finish();
+  }
+  // Hands what is buffered to the sink (call once at the end); no-op without a sink.
+  void finish() {
+    if (sink_ && !out_.empty()) sink_(out_);
+    if (sink_) out_.clear();
+  }
+  // The bytes so far; only meaningful without a sink.
   std::string& bytes() { return out_; }
 
  private:
+  Sink sink_;
   std::string out_;
 };
 

@@ -22,20 +22,46 @@ constexpr char kMagic[8] = {'V', 'O', 'X', 'G', 'R', 'I', 'D', '\n'};
 constexpr size_t kHeaderSize = 32;  // magic, version, flags, payload size, checksum
 
 // 64-bit multiplicative hash over 8-byte words: any change of one word changes the result (xor then multiply by an
-// odd constant are bijections), and it runs at memory speed.
-uint64_t wordChecksum(const char* data, size_t size) {
-  uint64_t h = 0x9E3779B97F4A7C15ull ^ size;
-  size_t i = 0;
-  for (; i + 8 <= size; i += 8) {
-    uint64_t w;
-    std::memcpy(&w, data + i, 8);
-    h = (h ^ w) * 0x100000001B3ull;
-    h ^= h >> 29;
+// odd constant are bijections), and it runs at memory speed. Fed in pieces of any length, so a file can be summed
+// as it is encoded; the payload size seeds it.
+class ChecksumStream {
+ public:
+  explicit ChecksumStream(uint64_t size) : h_(0x9E3779B97F4A7C15ull ^ size) {}
+  void update(std::string_view bytes) {
+    size_t i = 0;
+    if (carried_ > 0) {
+      while (carried_ < 8 && i < bytes.size()) carry_[carried_++] = bytes[i++];
+      if (carried_ < 8) return;
+      word(carry_);
+      carried_ = 0;
+    }
+    for (; i + 8 <= bytes.size(); i += 8) word(bytes.data() + i);
+    for (; i < bytes.size(); ++i) carry_[carried_++] = bytes[i];
   }
-  uint64_t tail = 0;
-  std::memcpy(&tail, data + i, size - i);
-  h = (h ^ tail) * 0x100000001B3ull;
-  return h ^ (h >> 32);
+  // The final 0-7 bytes, zero-extended to a word, end the sum.
+  uint64_t value() const {
+    uint64_t tail = 0;
+    std::memcpy(&tail, carry_, carried_);
+    uint64_t h = (h_ ^ tail) * 0x100000001B3ull;
+    return h ^ (h >> 32);
+  }
+
+ private:
+  void word(const char* p) {
+    uint64_t w;
+    std::memcpy(&w, p, 8);
+    h_ = (h_ ^ w) * 0x100000001B3ull;
+    h_ ^= h_ >> 29;
+  }
+  uint64_t h_;
+  char carry_[8] = {};
+  size_t carried_ = 0;
+};
+
+uint64_t wordChecksum(const char* data, size_t size) {
+  ChecksumStream sum(size);
+  sum.update({data, size});
+  return sum.value();
 }
 
 void putMaterial(ByteWriter& w, const Material& m) {
@@ -73,12 +99,12 @@ const std::vector<SectionCodec>& sectionCodecs() {
 void putSections(ByteWriter& w, const Scene& scene, const Grid& grid) {
   for (const SectionCodec& codec : sectionCodecs()) {
     if (!codec.has(scene, grid)) continue;
+    // The body is encoded apart first: its size comes before it, and a streaming writer cannot go back.
+    ByteWriter body;
+    codec.put(body, scene, grid);
     w.put(uint32_t(codec.tag));
-    const size_t sizeAt = w.bytes().size();
-    w.put(uint64_t(0));  // patched below, once the body's length is known
-    codec.put(w, scene, grid);
-    const uint64_t size = w.bytes().size() - sizeAt - 8;
-    std::memcpy(w.bytes().data() + sizeAt, &size, 8);
+    w.put(uint64_t(body.bytes().size()));
+    w.putBytes(body.bytes());
   }
 }
 
@@ -117,12 +143,10 @@ std::vector<CellRun> getSolidKeysAsRuns(ByteReader& r, uint64_t cells) {
 
 uint64_t gridChecksum(const char* payload, size_t size) { return wordChecksum(payload, size); }
 
-std::string encodeGridFile(const Scene& scene, const Grid& grid) {
-  ByteWriter w;
-  // The header is filled in last, in place, so the (possibly large) payload is never copied.
-  w.bytes().reserve(kHeaderSize + 256 + scene.triangles.size() * 76 + grid.cellKeys.size() * 16 + grid.primIds.size() * 4 +
-                    scene.materials.size() * 128);
-  w.bytes().assign(kHeaderSize, '\0');
+namespace {
+
+// The payload of docs/grid-format.md (everything after the 32-byte header).
+void encodePayload(ByteWriter& w, const Scene& scene, const Grid& grid) {
   // Scene.
   w.put(uint64_t(scene.materials.size()));
   for (const auto& m : scene.materials) putMaterial(w, m);
@@ -176,16 +200,38 @@ std::string encodeGridFile(const Scene& scene, const Grid& grid) {
   w.putArray(grid.outsidePrims);
   w.putArray(grid.solidRuns);
   putSections(w, scene, grid);
+}
 
+std::string encodeHeader(uint64_t payloadSize, uint64_t checksum) {
+  std::string header(kHeaderSize, '\0');
+  const uint32_t version = kGridFileVersion, flags = 0;
+  std::memcpy(header.data(), kMagic, 8);
+  std::memcpy(header.data() + 8, &version, 4);
+  std::memcpy(header.data() + 12, &flags, 4);
+  std::memcpy(header.data() + 16, &payloadSize, 8);
+  std::memcpy(header.data() + 24, &checksum, 8);
+  return header;
+}
+
+// Runs the encoder with every byte going to `sink`.
+void streamPayload(const Scene& scene, const Grid& grid, const ByteWriter::Sink& sink) {
+  ByteWriter w(sink);
+  encodePayload(w, scene, grid);
+  w.finish();
+}
+
+}  // namespace
+
+std::string encodeGridFile(const Scene& scene, const Grid& grid) {
+  ByteWriter w;
+  w.bytes().reserve(kHeaderSize + 256 + scene.triangles.size() * 76 + grid.cellKeys.size() * 16 + grid.primIds.size() * 4 +
+                    scene.materials.size() * 128);
+  w.bytes().assign(kHeaderSize, '\0');  // the header is filled in last, in place, so the payload is never copied
+  encodePayload(w, scene, grid);
   std::string bytes = std::move(w.bytes());
   const uint64_t payloadSize = bytes.size() - kHeaderSize;
-  const uint64_t sum = wordChecksum(bytes.data() + kHeaderSize, payloadSize);
-  const uint32_t version = kGridFileVersion, flags = 0;
-  std::memcpy(bytes.data(), kMagic, 8);
-  std::memcpy(bytes.data() + 8, &version, 4);
-  std::memcpy(bytes.data() + 12, &flags, 4);
-  std::memcpy(bytes.data() + 16, &payloadSize, 8);
-  std::memcpy(bytes.data() + 24, &sum, 8);
+  const std::string header = encodeHeader(payloadSize, wordChecksum(bytes.data() + kHeaderSize, payloadSize));
+  std::memcpy(bytes.data(), header.data(), kHeaderSize);
   return bytes;
 }
 
@@ -327,8 +373,16 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
 }
 
 void writeGridFile(const std::string& path, const Scene& scene, const Grid& grid) {
-  const std::string bytes = encodeGridFile(scene, grid);
-  writeFileAtomically(path, bytes);
+  // Three passes over the encoding instead of the whole file in memory (at 1024^3 the file is as large as the grid):
+  // the size, which seeds the checksum; the checksum; then the bytes, header first, through a temporary file.
+  uint64_t size = 0;
+  streamPayload(scene, grid, [&](std::string_view bytes) { size += bytes.size(); });
+  ChecksumStream sum(size);
+  streamPayload(scene, grid, [&](std::string_view bytes) { sum.update(bytes); });
+  OutputFile out(path);
+  out.write(encodeHeader(size, sum.value()));
+  streamPayload(scene, grid, [&](std::string_view bytes) { out.write(bytes); });
+  out.commit();
 }
 
 GridFile readGridFile(const std::string& path) {

@@ -11,7 +11,9 @@
 #include "test_util.h"
 #include "vox/core/error.h"
 #include "vox/io/atomic_file.h"
+#include "vox/io/info.h"
 #include "vox/io/input_file.h"
+#include "vox/import/import.h"
 
 namespace vox {
 namespace {
@@ -111,15 +113,15 @@ TEST(GridSet, ManifestsThatLieAreRefused) {
   m.entries[0].fileChecksum ^= 1;
   refused(m, "not the brick");
   m = good;
-  m.entries.clear();
-  refused(m, "at least one brick");
+  m.scene.checksum ^= 1;
+  refused(m, "not the scene file");
   // A brick moved to another brick's index: the cells are outside it.
   m = good;
   const auto moved = m.entries[1].index;
   m.entries[1].index = m.entries[0].index;
   m.entries[0].index = moved;
   std::swap(m.entries[0], m.entries[1]);
-  refused(m, "outside its brick");
+  refused(m, "holds another brick");
 }
 
 TEST(GridSet, NoManifestWhenABrickCannotBeWritten) {
@@ -130,6 +132,158 @@ TEST(GridSet, NoManifestWhenABrickCannotBeWritten) {
   std::filesystem::create_directories(dir.file("s.bricks/b_1_0_0.vgrid"));  // a folder where a brick goes
   EXPECT_THROW(writeGridSet(path, sceneWithPlane(5), o, {2, 1, 1}), OutputError);
   EXPECT_FALSE(std::filesystem::exists(path));
+}
+
+// A closed axis-aligned box surface [a, b]^3 of 12 outward-oriented triangles.
+Scene boxScene(double a, double b) {
+  Scene scene;
+  scene.materials.push_back({});
+  Vec3 p[8];
+  for (int c = 0; c < 8; ++c) p[c] = {(c & 1) ? b : a, (c & 2) ? b : a, (c & 4) ? b : a};
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads) {
+    scene.triangles.push_back({{p[q[0]], p[q[1]], p[q[2]]}});
+    scene.triangles.push_back({{p[q[0]], p[q[2]], p[q[3]]}});
+  }
+  return scene;
+}
+
+// --fill over a set gives the single grid's solid cells, run for run, for closed (flood) and open (winding number)
+// surfaces, spheres, and brick counts from one brick to bricks of one cell.
+TEST(GridSet, FillEqualsTheSingleGridsFill) {
+  testing::ScratchDir dir("gridset_fill");
+  Scene open = boxScene(0.15, 0.85);
+  open.triangles.resize(10);  // the face x = 0.85 removed: a hole, decided by winding number
+  Scene spheres;
+  spheres.materials.push_back({});
+  spheres.spheres.push_back({{0.35, 0.4, 0.5}, 0.25, {}, 0});
+  spheres.spheres.push_back({{0.7, 0.6, 0.45}, 0.2, {}, 0});
+  Scene twoBoxes = boxScene(0.1, 0.45);
+  for (const Triangle& t : boxScene(0.5, 0.9).triangles) twoBoxes.triangles.push_back(t);
+  const Scene bunny = loadScene(std::string(VOX_SEED_DIR) + "/meshes/bun_zipper.ply");  // scanned, open
+  struct Case {
+    const char* name;
+    const Scene* scene;
+    std::array<uint32_t, 3> dims;
+    FillRule rule;
+  };
+  const Case cases[] = {{"closed boxes", &twoBoxes, {9, 8, 7}, FillRule::Enclosed},
+                        {"open box", &open, {9, 8, 7}, FillRule::WindingNumber},
+                        {"spheres", &spheres, {13, 9, 10}, FillRule::Enclosed},
+                        {"open bunny", &bunny, {26, 25, 20}, FillRule::WindingNumber}};
+  for (const Case& c : cases) {
+    VoxelizeOptions o;
+    o.dims = c.dims;
+    if (c.scene != &bunny) o.bounds = Box{{0, 0, 0}, {1, 1, 1}};
+    Grid single = voxelizeScene(*c.scene, o);
+    const FillReport want = fillSolid(single, *c.scene);
+    ASSERT_EQ(want.rule, c.rule) << c.name;
+    ASSERT_GT(want.solidCells, 10u) << c.name;
+    // Bricks of one cell for the small grids (a file each); the bunny's grid in bricks of a few cells.
+    const std::array<uint32_t, 3> finest = c.scene == &bunny ? std::array<uint32_t, 3>{13, 5, 4} : c.dims;
+    for (const auto bricks : {std::array<uint32_t, 3>{1, 1, 1}, {7, 5, 3}, {2, 1, 4}, {1, 3, 1}, finest}) {
+      const std::string path = dir.file("f.vgrid");
+      std::filesystem::remove_all(dir.file("f.bricks"));
+      const FillOptions fo;
+      FillReport got;
+      const GridSetManifest m = writeGridSet(path, *c.scene, o, bricks, nullptr, &fo, &got);
+      const std::string what = std::string(c.name) + " in " + std::to_string(bricks[0]) + "x" +
+                               std::to_string(bricks[1]) + "x" + std::to_string(bricks[2]) + " bricks";
+      EXPECT_EQ(got.solidCells, want.solidCells) << what;
+      EXPECT_EQ(got.rule, want.rule) << what;
+      const GridFile set = readGridSet(path);
+      expectSameGrid(set.grid, single);
+      ASSERT_EQ(set.grid.solidRuns.size(), single.solidRuns.size()) << what;
+      for (size_t r = 0; r < single.solidRuns.size(); ++r) {
+        EXPECT_EQ(set.grid.solidRuns[r].first, single.solidRuns[r].first) << what << " run " << r;
+        EXPECT_EQ(set.grid.solidRuns[r].count, single.solidRuns[r].count) << what << " run " << r;
+      }
+      uint64_t solid = 0;
+      for (const BrickEntry& e : m.entries) solid += e.solid;
+      EXPECT_EQ(solid, want.solidCells) << what;
+    }
+  }
+}
+
+// vox-info streams a set one layer of bricks at a time; its report is the single grid's, byte for byte.
+TEST(GridSet, StreamedInfoEqualsTheSingleGrids) {
+  testing::ScratchDir dir("gridset_info");
+  const Scene scene = boxScene(0.1, 0.8);
+  VoxelizeOptions o;
+  o.dims = std::array<uint32_t, 3>{9, 8, 7};
+  o.bounds = Box{{0, 0, 0}, {1, 1, 1}};
+  Grid single = voxelizeScene(scene, o);
+  fillSolid(single, scene);
+  const GridFile file{scene, single};
+  for (const auto bricks : {std::array<uint32_t, 3>{1, 1, 1}, {3, 2, 4}, {9, 8, 7}}) {
+    const std::string path = dir.file("i.vgrid");
+    std::filesystem::remove_all(dir.file("i.bricks"));
+    const FillOptions fo;
+    writeGridSet(path, scene, o, bricks, nullptr, &fo);
+    for (const InfoOptions io : {InfoOptions{false, false, false}, InfoOptions{true, true, true}}) {
+      std::ostringstream out;
+      writeGridSetInfo(out, path, io);
+      EXPECT_EQ(out.str(), formatGridInfo(file, io));
+    }
+  }
+}
+
+// Brick and scene files are untrusted: every truncation and bit flip of a brick is refused with its name, and a
+// brick of another scene, a scene file of another set and an old-version manifest are refused.
+TEST(GridSet, CorruptBricksAndForeignSceneFilesAreRefused) {
+  testing::ScratchDir dir("gridset_brick");
+  VoxelizeOptions o;
+  o.dims = std::array<uint32_t, 3>{6, 5, 4};
+  const std::string path = dir.file("s.vgrid");
+  const GridSetManifest m = writeGridSet(path, sceneWithPlane(3), o, {3, 2, 2});
+  const uint64_t bounded = sceneWithPlane(3).boundedCount();
+  const std::string brick = slurp(dir.file(m.entries[0].file));
+  for (size_t n = 0; n < brick.size(); ++n)
+    EXPECT_THROW(decodeBrickFile(brick.substr(0, n), "b", m, m.entries[0], bounded), InputError);
+  for (size_t bit = 0; bit < brick.size() * 8; bit += 3) {
+    std::string b = brick;
+    b[bit / 8] = char(b[bit / 8] ^ (1 << (bit % 8)));
+    EXPECT_THROW(decodeBrickFile(b, "b", m, m.entries[0], bounded), InputError) << "bit " << bit;
+  }
+  EXPECT_NO_THROW(decodeBrickFile(brick, "b", m, m.entries[0], bounded));
+  // A brick written against another scene file (checksum), with a valid header of its own.
+  GridSetManifest other = m;
+  other.scene.checksum ^= 1;
+  const Grid cells = decodeBrickFile(brick, "b", m, m.entries[0], bounded);
+  try {
+    decodeBrickFile(encodeBrickFile(other, m.entries[0].index, cells), "b", m, m.entries[0], bounded);
+    ADD_FAILURE() << "accepted a brick of another scene";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("another scene file"), std::string::npos) << e.what();
+  }
+  // Primitive ids beyond the scene's.
+  EXPECT_THROW(decodeBrickFile(brick, "b", m, m.entries[0], 1), InputError);
+  // A brick named directly is not a grid.
+  try {
+    readGridOrSet(dir.file(m.entries[0].file));
+    ADD_FAILURE() << "read a brick as a grid";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("manifest"), std::string::npos) << e.what();
+  }
+  // Another set's scene file in place of this one's.
+  writeGridSet(dir.file("t.vgrid"), sceneWithPlane(4), o, {1, 1, 1});
+  std::filesystem::copy_file(dir.file("t.bricks/scene.vgrid"), dir.file("s.bricks/scene.vgrid"),
+                             std::filesystem::copy_options::overwrite_existing);
+  try {
+    readGridSet(path);
+    ADD_FAILURE() << "accepted a foreign scene file";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("scene.vgrid: not the scene file"), std::string::npos) << e.what();
+  }
+  // Version 1 manifests (the scene in every brick) are refused with what to do.
+  std::string v1 = slurp(path);
+  v1[8] = 1;
+  try {
+    decodeGridSetManifest(v1, "old.vgrid");
+    ADD_FAILURE() << "accepted version 1";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("voxelize the scene again"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

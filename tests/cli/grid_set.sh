@@ -83,7 +83,7 @@ for faces in all exposed merged; do
   same "export $faces of set and grid" "$T/a_$faces.ply" "$T/b_$faces.ply"
 done
 
-# A scene of planes only: no occupied cell, yet the set keeps its scene (one empty brick file).
+# A scene of planes only: no occupied cell, no brick file; the set's scene file keeps the planes.
 printf 'OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 5 }\nLights { numLights 1 DirectionalLight { direction 0 0 -1 color 1 1 1 } }\nBackground { color 0 0 0 ambientLight 0.2 0.2 0.2 }\nMaterials { numMaterials 1 Material { diffuseColor 1 0 0 } }\nGroup { numObjects 1 MaterialIndex 0 Plane { normal 0 1 0 offset -1 } }\n' >"$T/planes.txt"
 check "planes only single" 0 "$V" "$T/planes.txt" -o "$T/p.vgrid" -q
 check "planes only set" 0 "$V" "$T/planes.txt" -o "$T/p_set.vgrid" --bricks 1 1 1 -q
@@ -91,9 +91,29 @@ check "planes trace" 0 "$TR" "$T/p.vgrid" -o "$T/p1.png" --size 32 32 -q
 check "planes set trace" 0 "$TR" "$T/p_set.vgrid" -o "$T/p2.png" --size 32 32 -q
 same "planes-only set traces as its grid" "$T/p1.png" "$T/p2.png"
 
+# --fill with --bricks: the same solid cells as the single grid (vox-info counts them and their runs in
+# memory_bytes; vox-export draws them), closed (flood) and open (winding number) meshes, several brick counts.
+compare_fill() {  # compare_fill TAG SCENE "GRID ARGS" "BRICKS"
+  local tag=$1 scene=$2 args=$3 bricks=$4
+  check "$tag fill single" 0 "$V" "$scene" -o "$T/$tag.vgrid" $args --fill -q
+  check "$tag fill set" 0 "$V" "$scene" -o "$T/${tag}_set.vgrid" $args --fill --bricks $bricks -q
+  check "$tag fill info" 0 "$I" "$T/$tag.vgrid" --json --cells
+  mv "$T/out" "$T/$tag.json"
+  check "$tag fill set info" 0 "$I" "$T/${tag}_set.vgrid" --json --cells
+  same "$tag: vox-info of the filled set and grid" "$T/$tag.json" "$T/out"
+  grep -q '"solid_cells": [1-9]' "$T/out" || { echo "FAIL $tag: nothing filled"; fails=$((fails + 1)); }
+  check "$tag fill export" 0 "$E" "$T/$tag.vgrid" -o "$T/$tag.ply" --faces all --color none -q
+  check "$tag fill set export" 0 "$E" "$T/${tag}_set.vgrid" -o "$T/${tag}_set.ply" --faces all --color none -q
+  same "$tag: export of the filled set and grid" "$T/$tag.ply" "$T/${tag}_set.ply"
+}
+compare_fill fill_bunny "$S/scene5_07_bunny_mesh_1k.txt" "--grid 15 15 12" "7 5 3"
+compare_fill fill_bunny1 "$S/scene5_07_bunny_mesh_1k.txt" "--grid 15 15 12" "1 1 1"
+compare_fill fill_sphere "$S/scene5_01_sphere.txt" "--grid 7 6 5" "7 6 5"  # bricks of one cell
+compare_fill fill_open "$SEED/meshes/bun_zipper.ply" "--res 24" "3 2 2"  # open: winding number
+check "set fill says how" 0 "$V" "$S/scene5_07_bunny_mesh_1k.txt" -o "$T/say.vgrid" --grid 8 8 8 --fill --bricks 2 2 2
+grep -q "fill: closed surface" "$T/err" || { echo "FAIL set --fill does not say how it decided"; fails=$((fails + 1)); }
+
 # Usage errors: one line, exit 1, nothing written.
-check "fill with bricks" 1 "$V" "$S/scene5_01_sphere.txt" -o "$T/f.vgrid" --bricks 2 2 2 --fill
-expect_err "fill with bricks" "fill cannot be combined with --bricks"
 check "more bricks than cells" 1 "$V" "$S/scene5_01_sphere.txt" -o "$T/f.vgrid" --grid 4 4 4 --bricks 5 1 1
 expect_err "more bricks than cells" "5 bricks on axis x"
 check "zero bricks" 1 "$V" "$S/scene5_01_sphere.txt" -o "$T/f.vgrid" --bricks 0 1 1
@@ -120,7 +140,7 @@ expect_err "corrupt manifest" "bad.vgrid: byte .*checksum"
 head -c 50 "$T/spheres_set.vgrid" >"$T/short.vgrid"
 check "truncated manifest" 2 "$I" "$T/short.vgrid"
 expect_err "truncated manifest" "short.vgrid: truncated"
-first=$(ls "$T/spheres_set.bricks" | head -1)
+first=$(ls "$T/spheres_set.bricks" | grep "^b_" | head -1)
 mv "$T/spheres_set.bricks/$first" "$T/moved.vgrid"
 check "missing brick" 2 "$TR" "$T/spheres_set.vgrid" -o "$T/m.png"
 expect_err "missing brick" "$first"
@@ -128,6 +148,15 @@ expect_err "missing brick" "$first"
 cp "$T/squashed.vgrid" "$T/spheres_set.bricks/$first"  # another grid in its place
 check "foreign brick" 2 "$E" "$T/spheres_set.vgrid" -o "$T/m.ply"
 expect_err "foreign brick" "not the brick"
+# The scene file, stored once: missing or another set's is named; a brick opened directly is named as one.
+cp "$T/plane_set.bricks/scene.vgrid" "$T/spheres_set.bricks/scene.vgrid"
+check "foreign scene file" 2 "$I" "$T/spheres_set.vgrid"
+expect_err "foreign scene file" "spheres_set.bricks/scene.vgrid: not the scene file"
+rm "$T/plane_set.bricks/scene.vgrid"
+check "missing scene file" 2 "$TR" "$T/plane_set.vgrid" -o "$T/m.png"
+expect_err "missing scene file" "plane_set.bricks/scene.vgrid"
+check "brick opened directly" 2 "$I" "$T/bbox_set.bricks/$(ls "$T/bbox_set.bricks" | grep '^b_' | head -1)"
+expect_err "brick opened directly" "a brick of a grid set"
 
 echo "grid_set.sh: $passes passed, $fails failed"
 [ $fails = 0 ]

@@ -1,5 +1,6 @@
 // vox-info: statistics of a grid file, as text or JSON, on stdout.
 #include <cstdio>
+#include <iostream>
 
 #include "../common/cli.h"
 #include "vox/io/grid_file.h"
@@ -20,9 +21,13 @@ int main(int argc, char** argv) {
   vox::cli::addCommonOptions(app, common);
   if (auto code = vox::cli::parse(app, argc, argv)) return *code;
   return vox::runTool("vox-info", [&] {
-    const vox::GridFile file = vox::readGridOrSet(path);
-    const std::string text = vox::formatGridInfo(file, options);
-    std::fwrite(text.data(), 1, text.size(), stdout);
-    return std::fflush(stdout) == 0 ? vox::kExitOk : vox::kExitCannotWrite;
+    // A set is streamed a layer of bricks at a time, so listing its cells needs no more memory than a layer.
+    std::ios::sync_with_stdio(false);
+    if (vox::isGridSet(path))
+      vox::writeGridSetInfo(std::cout, path, options);
+    else
+      vox::writeGridInfo(std::cout, vox::readGridFile(path), options);
+    std::cout.flush();
+    return std::cout ? vox::kExitOk : vox::kExitCannotWrite;
   });
 }

@@ -98,6 +98,7 @@ std::string pack(const Outcome& o) {
     p.put(e.fileChecksum);
     p.put(e.occupied);
     p.put(e.references);
+    p.put(e.solid);
   }
   p.put(uint64_t(o.scenes.size()));
   for (const auto& [index, result] : o.scenes) {
@@ -126,6 +127,7 @@ Outcome unpack(const std::string& bytes) {
     u.get(e.fileChecksum);
     u.get(e.occupied);
     u.get(e.references);
+    u.get(e.solid);
   }
   u.get(n);
   o.scenes.resize(n);
@@ -227,12 +229,12 @@ int runSet(const Options& opt, int rank, int size) {
   Outcome mine;
   Scene scene;
   Grid plan;
+  GridSetManifest set;
   std::vector<std::vector<uint32_t>> candidates;
   std::vector<uint64_t> order;
   const VoxelizeOptions vo = voxelizeOptions(opt);
   mine.code = capture(
       [&] {
-        if (opt.fill) fail<UsageError>("--fill cannot be combined with --bricks");
         checkOutputPath(opt.output, {opt.scene});
         scene = loadScene(opt.scene);
         namingScene(opt.scene, [&] {
@@ -241,11 +243,13 @@ int runSet(const Options& opt, int rank, int size) {
           if (vo.bounds) plan.outsidePrims = primitivesOutside(scene, plan);
           candidates = brickCandidates(scene, plan, bricks, vo.memoryLimitBytes);
         });
+        // Every rank encodes the scene file to know its checksum (the bricks name it); rank 0 writes it.
+        if (rank == 0) makeBrickFolder(opt.output);
+        set = {plan.bounds, plan.dims, plan.method, bricks, writeGridSetScene(opt.output, scene, plan, rank == 0), {}};
         for (uint64_t b = 0; b < candidates.size(); ++b)
           if (!candidates[b].empty()) order.push_back(b);
         std::stable_sort(order.begin(), order.end(),
                          [&](uint64_t a, uint64_t b) { return candidates[a].size() > candidates[b].size(); });
-        if (rank == 0) makeBrickFolder(opt.output);
       },
       mine.message);
   int anyFailed = mine.code;
@@ -260,8 +264,7 @@ int runSet(const Options& opt, int rank, int size) {
           [&] {
             namingScene(opt.scene, [&] {
               const uint64_t b = order[item];
-              mine.bricks.push_back(
-                  writeBrick(opt.output, scene, plan, bricks, brickIndex(bricks, b), candidates[b], vo));
+              mine.bricks.push_back(writeBrick(opt.output, set, scene, plan, brickIndex(bricks, b), candidates[b], vo));
             });
           },
           mine.message);
@@ -288,14 +291,18 @@ int runSet(const Options& opt, int rank, int size) {
       std::string message;
       code = capture(
           [&] {
-            GridSetManifest m{plan.bounds, plan.dims, plan.method, bricks, {}};
+            GridSetManifest m = set;
             for (const auto& o : all) m.entries.insert(m.entries.end(), o.bricks.begin(), o.bricks.end());
             std::erase_if(m.entries, [](const BrickEntry& e) { return e.occupied == 0; });
-            if (m.entries.empty())  // the scene lives in the bricks: an empty set keeps brick (0,0,0)
-              m.entries.push_back(writeBrick(opt.output, scene, plan, bricks, {0, 0, 0}, {}, vo, nullptr, true));
             std::sort(m.entries.begin(), m.entries.end(), [&](const BrickEntry& a, const BrickEntry& b) {
               return brickNumber(bricks, a.index) < brickNumber(bricks, b.index);
             });
+            // The fill needs every brick's cells: rank 0 runs it over the written bricks (fillGridSet).
+            if (opt.fill)
+              namingScene(opt.scene, [&] {
+                const FillReport report = fillGridSet(opt.output, m, scene, FillOptions{vo.memoryLimitBytes, {}, {}, false});
+                if (!opt.common.quiet) std::fprintf(stderr, "vox-voxelize-mpi: fill: %s\n", describeFill(report).c_str());
+              });
             writeGridSetManifest(opt.output, m);
           },
           message);
@@ -452,7 +459,9 @@ int main(int argc, char** argv) {
       ->expected(6);
   app.add_option("--method", opt.method, "Overlap test: exact (default), sat, bbox, center")
       ->check(CLI::IsMember({"exact", "sat", "bbox", "center"}));
-  app.add_flag("--fill", opt.fill, "Batch only: also mark the empty cells inside closed surfaces as solid");
+  app.add_flag("--fill", opt.fill,
+               "Also mark the empty cells inside the surfaces as solid (with --bricks: rank 0 fills over the "
+               "written bricks; the same solid cells as vox-voxelize --fill)");
   app.add_option("--bricks", opt.bricks, "Bricks BX BY BZ of the grid set (one scene)")
       ->expected(3)
       ->check(CLI::Range(1u, vox::kMaxCellsPerAxis));

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <optional>
 
 #include "../common/cli.h"
 #include "vox/io/atomic_file.h"
@@ -30,7 +31,15 @@ struct Options {
   vox::cli::CommonOptions common;
 };
 
-// --bricks: the grid set of docs/grid-format.md, brick after brick.
+// How the fill decided is always said (an open mesh once filled nothing, silently).
+void reportFill(const Options& opt, const vox::FillReport& report) {
+  if (opt.common.quiet) return;
+  std::fprintf(stderr, "vox-voxelize: fill: %s\n", vox::describeFill(report).c_str());
+  if (const std::string w = vox::fillWarning(report); !w.empty())
+    std::fprintf(stderr, "vox-voxelize: warning: %s: fill: %s\n", opt.scene.c_str(), w.c_str());
+}
+
+// --bricks: the grid set of docs/grid-format.md, brick after brick, then the fill over the bricks' cells.
 int runSet(const Options& opt, const vox::Scene& scene, vox::VoxelizeOptions vo,
            std::chrono::steady_clock::time_point start) {
   using namespace vox;
@@ -41,31 +50,45 @@ int runSet(const Options& opt, const vox::Scene& scene, vox::VoxelizeOptions vo,
   };
   VoxelizeStats stats;
   GridSetManifest set;
+  std::optional<ProgressBar> fillBar;
+  FillOptions fo;
+  fo.memoryLimitBytes = vo.memoryLimitBytes;
+  fo.progress = [&](double f) {
+    if (!fillBar) bar.finish(), fillBar.emplace("filling", opt.common.quiet);
+    fillBar->update(f);
+    return true;
+  };
+  FillReport report;
   try {
-    set = writeGridSet(opt.output, scene, vo, {opt.bricks[0], opt.bricks[1], opt.bricks[2]}, &stats);
+    set = writeGridSet(opt.output, scene, vo, {opt.bricks[0], opt.bricks[1], opt.bricks[2]}, &stats,
+                       opt.fill ? &fo : nullptr, &report);
     bar.finish();
+    if (fillBar) fillBar->finish();
   } catch (const LimitError& e) {
     fail<LimitError>(opt.scene, ": ", e.what());
   } catch (const InputError& e) {
     fail<InputError>(opt.scene, ": ", e.what());
   }
+  if (opt.fill) reportFill(opt, report);
   if (opt.stats) {
     rusage usage{};
     ::getrusage(RUSAGE_SELF, &usage);
-    uint64_t occupied = 0, references = 0;
+    uint64_t occupied = 0, references = 0, solid = 0;
     for (const BrickEntry& e : set.entries) {
       occupied += e.occupied;
       references += e.references;
+      solid += e.solid;
     }
     const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::fprintf(stderr,
                  "triangles: %zu\nspheres: %zu\nplanes: %zu\ndims: %u %u %u\nmethod: %s\nbricks: %u %u %u\n"
                  "brick_files: %zu\ncells_tested: %llu\nexact_fallbacks: %llu\noccupied_cells: %llu\n"
-                 "references: %llu\nvoxelize_seconds: %.6f\ntotal_seconds: %.6f\npeak_memory_mb: %.1f\n",
+                 "solid_cells: %llu\nreferences: %llu\nvoxelize_seconds: %.6f\ntotal_seconds: %.6f\n"
+                 "peak_memory_mb: %.1f\n",
                  scene.triangles.size(), scene.spheres.size(), scene.planes.size(), set.dims[0], set.dims[1],
                  set.dims[2], methodName(set.method).c_str(), set.bricks[0], set.bricks[1], set.bricks[2],
                  set.entries.size(), (unsigned long long)stats.cellsTested, (unsigned long long)stats.exactFallbacks,
-                 (unsigned long long)occupied, (unsigned long long)references, stats.seconds, total,
+                 (unsigned long long)occupied, (unsigned long long)solid, (unsigned long long)references, stats.seconds, total,
                  double(usage.ru_maxrss) / 1024.0);
   }
   return kExitOk;
@@ -84,8 +107,6 @@ int run(const Options& opt) {
 
   // Before the scene is read: `-o scene.glb` would destroy the scene.
   checkOutputPath(opt.output, {opt.scene});
-  // Fill is a flood over the whole grid; brick by brick it would need the neighbours' answers (README).
-  if (!opt.bricks.empty() && opt.fill) fail<UsageError>("--fill cannot be combined with --bricks");
   const Scene scene = loadScene(opt.scene);
   if (!opt.common.quiet)
     for (const auto& w : scene.warnings)
@@ -111,10 +132,7 @@ int run(const Options& opt) {
       };
       const FillReport report = fillSolid(grid, scene, fo);
       fillBar.finish();
-      // How the fill decided is always said (an open mesh once filled nothing, silently).
-      if (!opt.common.quiet) std::fprintf(stderr, "vox-voxelize: fill: %s\n", describeFill(report).c_str());
-      if (const std::string w = fillWarning(report); !w.empty() && !opt.common.quiet)
-        std::fprintf(stderr, "vox-voxelize: warning: %s: fill: %s\n", opt.scene.c_str(), w.c_str());
+      reportFill(opt, report);
     }
   } catch (const LimitError& e) {
     fail<LimitError>(opt.scene, ": ", e.what());  // what the scene asks for is named with the scene
@@ -164,8 +182,9 @@ int main(int argc, char** argv) {
                "Also mark the empty cells inside the surfaces as solid: flood fill for closed meshes, |winding "
                "number| >= 0.5 for open ones; says which on stderr");
   app.add_option("--bricks", opt.bricks,
-                 "Write a grid set: OUT is a manifest naming one grid file per non-empty brick of BX x BY x BZ "
-                 "bricks (in OUT_NAME.bricks/ beside it), voxelized one brick at a time")
+                 "Write a grid set: OUT is a manifest naming the scene file and one brick file per non-empty brick "
+                 "of BX x BY x BZ bricks (in OUT_NAME.bricks/ beside it), voxelized one brick at a time; with "
+                 "--fill, the fill runs over all bricks' cells afterwards")
       ->expected(3)
       ->check(CLI::Range(1u, vox::kMaxCellsPerAxis));
   app.add_flag("--stats", opt.stats, "Print statistics (name: value) on stderr");

@@ -1,28 +1,17 @@
 // Grid-set manifests and reading a set back (docs/grid-format.md "Grid sets"). The manifest is untrusted input like
-// a grid file: every count, index and name is checked, and a brick must lie inside the manifest's folder.
+// a grid file: every count, index and name is checked, and the scene file and bricks must lie inside the manifest's
+// folder.
 #include "vox/io/grid_set.h"
 
 #include <algorithm>
-#include <cstring>
 #include <fstream>
 
-#include "io/byte_codec.h"
-#include "vox/core/error.h"
+#include "io/grid_set_header.h"
 #include "vox/io/input_file.h"
 
 namespace vox {
 
 namespace {
-
-constexpr char kSetMagic[8] = {'V', 'O', 'X', 'G', 'S', 'E', 'T', '\n'};
-constexpr size_t kHeaderSize = 32;  // magic, version, flags, payload size, checksum (as the grid file)
-constexpr size_t kGridChecksumOffset = 24;
-
-uint64_t headerChecksum(const std::string& fileBytes) {
-  uint64_t c = 0;
-  if (fileBytes.size() >= kHeaderSize) std::memcpy(&c, fileBytes.data() + kGridChecksumOffset, 8);
-  return c;
-}
 
 void putEntry(ByteWriter& w, const BrickEntry& e) {
   for (uint32_t i : e.index) w.put(i);
@@ -31,6 +20,7 @@ void putEntry(ByteWriter& w, const BrickEntry& e) {
   w.put(e.fileChecksum);
   w.put(e.occupied);
   w.put(e.references);
+  w.put(e.solid);
 }
 
 BrickEntry getEntry(ByteReader& r) {
@@ -41,6 +31,7 @@ BrickEntry getEntry(ByteReader& r) {
   e.fileChecksum = r.get<uint64_t>();
   e.occupied = r.get<uint64_t>();
   e.references = r.get<uint64_t>();
+  e.solid = r.get<uint64_t>();
   return e;
 }
 
@@ -66,25 +57,30 @@ void getPlan(ByteReader& r, GridSetManifest& m) {
   }
 }
 
-// Entries in strictly ascending brick order, named by relative paths, counts adding up to the totals.
-void checkEntries(ByteReader& r, const GridSetManifest& m, uint64_t occupied, uint64_t references) {
-  uint64_t sumOccupied = 0, sumReferences = 0;
+bool badName(const std::string& file) { return file.empty() || file.find('\0') != std::string::npos; }
+
+// Entries in strictly ascending brick order, named, none empty, counts adding up to the totals.
+void checkEntries(ByteReader& r, const GridSetManifest& m, uint64_t occupied, uint64_t references, uint64_t solid) {
+  uint64_t sum[3] = {0, 0, 0};
   for (size_t i = 0; i < m.entries.size(); ++i) {
     const BrickEntry& e = m.entries[i];
+    const std::string which = "brick " + std::to_string(i) + ": ";
     for (int a = 0; a < 3; ++a)
-      if (e.index[a] >= m.bricks[a]) r.corrupt("brick " + std::to_string(i) + ": index out of range");
+      if (e.index[a] >= m.bricks[a]) r.corrupt(which + "index out of range");
     if (i > 0 && brickNumber(m.bricks, e.index) <= brickNumber(m.bricks, m.entries[i - 1].index))
       r.corrupt("bricks not in ascending order");
-    if (e.file.empty() || e.file.find('\0') != std::string::npos)
-      r.corrupt("brick " + std::to_string(i) + ": bad file name");
-    if (e.occupied == 0 && m.entries.size() > 1) r.corrupt("brick " + std::to_string(i) + ": empty brick listed");
-    if (e.references < e.occupied) r.corrupt("brick " + std::to_string(i) + ": fewer references than cells");
-    sumOccupied += e.occupied;
-    sumReferences += e.references;
-    if (sumOccupied < e.occupied || sumReferences < e.references) r.corrupt("cell counts overflow");
+    if (badName(e.file)) r.corrupt(which + "bad file name");
+    if (e.occupied == 0 && e.solid == 0) r.corrupt(which + "empty brick listed");
+    if (e.references < e.occupied || (e.occupied == 0) != (e.references == 0))
+      r.corrupt(which + "references do not match the cells");
+    const uint64_t add[3] = {e.occupied, e.references, e.solid};
+    for (int k = 0; k < 3; ++k) {
+      sum[k] += add[k];
+      if (sum[k] < add[k]) r.corrupt("cell counts overflow");
+    }
   }
-  if (m.entries.empty()) r.corrupt("a set names at least one brick (it carries the scene)");
-  if (sumOccupied != occupied || sumReferences != references) r.corrupt("brick counts do not add up to the totals");
+  if (sum[0] != occupied || sum[1] != references || sum[2] != solid)
+    r.corrupt("brick counts do not add up to the totals");
 }
 
 }  // namespace
@@ -96,54 +92,45 @@ std::string encodeGridSetManifest(const GridSetManifest& m) {
   for (uint32_t n : m.dims) w.put(n);
   w.put(uint8_t(m.method));
   for (uint32_t b : m.bricks) w.put(b);
-  uint64_t occupied = 0, references = 0;
+  uint64_t occupied = 0, references = 0, solid = 0;
   for (const BrickEntry& e : m.entries) {
     occupied += e.occupied;
     references += e.references;
+    solid += e.solid;
   }
   w.put(occupied);
   w.put(references);
+  w.put(solid);
+  w.putString(m.scene.file);
+  w.put(m.scene.fileSize);
+  w.put(m.scene.checksum);
   w.put(uint64_t(m.entries.size()));
   for (const BrickEntry& e : m.entries) putEntry(w, e);
-  const std::string& payload = w.bytes();
-  ByteWriter h;
-  h.bytes().append(kSetMagic, 8);
-  h.put(kGridSetVersion);
-  h.put(uint32_t(0));
-  h.put(uint64_t(payload.size()));
-  h.put(gridChecksum(payload.data(), payload.size()));
-  return h.bytes() + payload;
+  return withSetHeader(kSetMagic, kGridSetVersion, w.bytes());
 }
 
 GridSetManifest decodeGridSetManifest(const std::string& bytes, const std::string& name) {
-  ByteReader r(bytes, 0, name);
-  r.need(kHeaderSize);
-  if (std::memcmp(bytes.data(), kSetMagic, 8) != 0) r.corrupt("not a grid-set manifest (bad magic)");
-  ByteReader h(bytes, 8, name);
-  const uint32_t version = h.get<uint32_t>();
-  if (version == 0 || version > kGridSetVersion)
-    h.corrupt("manifest version " + std::to_string(version) + " (this reader knows 1 to " +
-              std::to_string(kGridSetVersion) + ")");
-  if (h.get<uint32_t>() != 0) h.corrupt("unknown flags");
-  const uint64_t size = h.get<uint64_t>();
-  if (size != bytes.size() - kHeaderSize) {
-    if (size > bytes.size() - kHeaderSize)
-      fail<InputError>(name, ": truncated at byte ", bytes.size(), " (header promises ", kHeaderSize + size,
-                       " bytes)");
-    h.corrupt("payload size " + std::to_string(size) + " does not match the file");
-  }
-  if (h.get<uint64_t>() != gridChecksum(bytes.data() + kHeaderSize, size)) h.corrupt("checksum mismatch");
+  if (bytes.size() >= 12 && std::memcmp(bytes.data(), kSetMagic, 8) == 0 && bytes[8] == 1 && bytes[9] == 0 &&
+      bytes[10] == 0 && bytes[11] == 0)
+    fail<InputError>(name, ": grid-set version 1 (every brick carried the whole scene) is no longer read: "
+                           "voxelize the scene again with --bricks");
+  checkSetHeader(bytes, name, kSetMagic, kGridSetVersion, "grid-set manifest");
   GridSetManifest m;
-  ByteReader p(bytes, kHeaderSize, name);
+  ByteReader p(bytes, kSetHeaderSize, name);
   getPlan(p, m);
   const uint64_t occupied = p.get<uint64_t>();
   const uint64_t references = p.get<uint64_t>();
-  // The smallest entry is 3 u32, an empty name's u32 and 4 u64.
-  const uint64_t count = p.getCount(48, "brick");
+  const uint64_t solid = p.get<uint64_t>();
+  m.scene.file = p.getString();
+  if (badName(m.scene.file)) p.corrupt("bad scene file name");
+  m.scene.fileSize = p.get<uint64_t>();
+  m.scene.checksum = p.get<uint64_t>();
+  // The smallest entry is 3 u32, an empty name's u32 and 5 u64.
+  const uint64_t count = p.getCount(56, "brick");
   m.entries.reserve(count);
   for (uint64_t i = 0; i < count; ++i) m.entries.push_back(getEntry(p));
   if (!p.atEnd()) p.corrupt("trailing bytes after the bricks");
-  checkEntries(p, m, occupied, references);
+  checkEntries(p, m, occupied, references, solid);
   return m;
 }
 
@@ -151,46 +138,51 @@ GridSetManifest readGridSetManifest(const std::string& path) {
   return decodeGridSetManifest(readInputFile(path, "grid-set manifest"), path);
 }
 
-GridFile readBrick(const std::string& setPath, const GridSetManifest& m, size_t entry) {
+GridFile readGridSetScene(const std::string& setPath, const GridSetManifest& m) {
+  // Refuses absolute names and names leaving the manifest's folder (after "..", symbolic links included).
+  const std::string path = resolveInsideFolder(setPath, m.scene.file);
+  const std::string bytes = readInputFile(path, "grid-set scene file");
+  if (bytes.size() != m.scene.fileSize || headerChecksum(bytes) != m.scene.checksum)
+    fail<InputError>(path, ": not the scene file ", setPath, " names (size or checksum differ; rewritten since?)");
+  GridFile file = decodeGridFile(bytes, path);
+  const Grid& g = file.grid;
+  auto same = [](const Vec3& a, const Vec3& b) { return a.x == b.x && a.y == b.y && a.z == b.z; };
+  if (!same(g.bounds.lo, m.bounds.lo) || !same(g.bounds.hi, m.bounds.hi) || g.dims != m.dims || g.method != m.method)
+    fail<InputError>(path, ": bounds, dims or method differ from its manifest ", setPath);
+  if (g.occupiedCount() != 0 || !g.solidRuns.empty()) fail<InputError>(path, ": a set's scene file holds no cells");
+  return file;
+}
+
+Grid readBrick(const std::string& setPath, const GridSetManifest& m, size_t entry, uint64_t boundedCount) {
   VOX_CHECK(entry < m.entries.size());
   const BrickEntry& e = m.entries[entry];
-  // Refuses absolute names and names leaving the manifest's folder (after "..", symbolic links included).
   const std::string path = resolveInsideFolder(setPath, e.file);
   const std::string bytes = readInputFile(path, "brick file");
   if (bytes.size() != e.fileSize || headerChecksum(bytes) != e.fileChecksum)
     fail<InputError>(path, ": not the brick ", setPath, " names (size or checksum differ; rewritten since?)");
-  GridFile brick = decodeGridFile(bytes, path);
-  const Grid& g = brick.grid;
-  auto same = [](const Vec3& a, const Vec3& b) { return a.x == b.x && a.y == b.y && a.z == b.z; };
-  if (!same(g.bounds.lo, m.bounds.lo) || !same(g.bounds.hi, m.bounds.hi) || g.dims != m.dims || g.method != m.method)
-    fail<InputError>(path, ": bounds, dims or method differ from its manifest ", setPath);
-  if (g.occupiedCount() != e.occupied || g.referenceCount() != e.references)
-    fail<InputError>(path, ": cell or reference count differs from its manifest ", setPath);
-  const CellWindow w = brickWindow(m.dims, m.bricks, e.index);
-  for (uint64_t key : g.cellKeys) {
-    const auto ijk = cellIndex(g.dims, key);
-    for (int a = 0; a < 3; ++a)
-      if (ijk[a] < w.first[a] || ijk[a] >= w.end[a])
-        fail<InputError>(path, ": cell (", ijk[0], ", ", ijk[1], ", ", ijk[2], ") outside its brick");
-  }
-  if (!g.solidRuns.empty()) fail<InputError>(path, ": a brick holds no solid cells");
-  return brick;
+  return decodeBrickFile(bytes, path, m, e, boundedCount);
 }
 
 namespace {
 
-// Appends a brick's cells to the whole grid. Bricks are disjoint boxes, so the merged keys are the union; they are
-// sorted once at the end when the bricks interleave (any brick count above one along x or y).
+// Appends a brick's cells to `whole`; the caller sorts when bricks interleave.
 void appendBrick(Grid& whole, const Grid& brick) {
-  for (size_t c = 0; c < brick.occupiedCount(); ++c) {
-    whole.cellKeys.push_back(brick.cellKeys[c]);
-    const auto prims = brick.cellPrims(c);
-    whole.primIds.insert(whole.primIds.end(), prims.begin(), prims.end());
-    whole.cellStart.push_back(whole.primIds.size());
-  }
+  whole.cellKeys.insert(whole.cellKeys.end(), brick.cellKeys.begin(), brick.cellKeys.end());
+  const uint64_t base = whole.primIds.size();
+  for (size_t c = 1; c < brick.cellStart.size(); ++c) whole.cellStart.push_back(base + brick.cellStart[c]);
+  whole.primIds.insert(whole.primIds.end(), brick.primIds.begin(), brick.primIds.end());
+  whole.solidRuns.insert(whole.solidRuns.end(), brick.solidRuns.begin(), brick.solidRuns.end());
 }
 
+// Cells sorted by key (bricks side by side along x or y interleave), solid runs sorted and merged where they touch.
 void sortCells(Grid& grid) {
+  std::sort(grid.solidRuns.begin(), grid.solidRuns.end(),
+            [](const CellRun& a, const CellRun& b) { return a.first < b.first; });
+  std::vector<CellRun> runs;
+  runs.reserve(grid.solidRuns.size());
+  for (const CellRun& r : grid.solidRuns) appendSolidRun(runs, r);
+  grid.solidRuns = std::move(runs);
+  if (std::is_sorted(grid.cellKeys.begin(), grid.cellKeys.end())) return;
   const size_t n = grid.occupiedCount();
   std::vector<uint32_t> order(n);
   for (size_t c = 0; c < n; ++c) order[c] = uint32_t(c);
@@ -210,7 +202,28 @@ void sortCells(Grid& grid) {
   grid.primIds = std::move(sorted.primIds);
 }
 
+Grid emptyLike(const Grid& plan) {
+  Grid g;
+  g.bounds = plan.bounds;
+  g.dims = plan.dims;
+  g.method = plan.method;
+  return g;
+}
+
 }  // namespace
+
+void forEachGridSetLayer(const std::string& setPath, const GridSetManifest& m, const GridFile& sceneFile,
+                         const std::function<void(const Grid& layer)>& visit) {
+  size_t i = 0;
+  for (uint32_t bz = 0; bz < m.bricks[2]; ++bz) {
+    Grid layer = emptyLike(sceneFile.grid);
+    for (; i < m.entries.size() && m.entries[i].index[2] == bz; ++i)
+      appendBrick(layer, readBrick(setPath, m, i, sceneFile.scene.boundedCount()));
+    if (layer.cellKeys.size() > UINT32_MAX) fail<LimitError>(setPath, ": a layer of bricks holds more than 2^32 cells");
+    sortCells(layer);
+    visit(layer);
+  }
+}
 
 GridFile readGridSet(const std::string& path) {
   const GridSetManifest m = readGridSetManifest(path);
@@ -221,27 +234,13 @@ GridFile readGridSet(const std::string& path) {
   }
   checkMemory(double(occupied) * 16 + double(references) * 4 + double(occupied) * 4, path, "the assembled grid");
   if (occupied > UINT32_MAX) fail<LimitError>(path, ": ", occupied, " cells are more than one process assembles");
-  GridFile whole;
-  for (size_t i = 0; i < m.entries.size(); ++i) {
-    GridFile brick = readBrick(path, m, i);
-    if (i == 0) {
-      whole.scene = std::move(brick.scene);
-      whole.grid = brick.grid;
-      whole.grid.cellKeys.clear();
-      whole.grid.cellStart.assign(1, 0);
-      whole.grid.primIds.clear();
-      whole.grid.cellKeys.reserve(occupied);
-      whole.grid.cellStart.reserve(occupied + 1);
-      whole.grid.primIds.reserve(references);
-    } else if (brick.scene.triangles.size() != whole.scene.triangles.size() ||
-               brick.scene.spheres.size() != whole.scene.spheres.size() ||
-               brick.scene.planes.size() != whole.scene.planes.size() ||
-               brick.grid.outsidePrims != whole.grid.outsidePrims) {
-      fail<InputError>(resolveInsideFolder(path, m.entries[i].file), ": its scene differs from the set's first brick");
-    }
-    appendBrick(whole.grid, brick.grid);
-  }
-  if (!std::is_sorted(whole.grid.cellKeys.begin(), whole.grid.cellKeys.end())) sortCells(whole.grid);
+  GridFile whole = readGridSetScene(path, m);
+  Grid& g = whole.grid;
+  g.cellKeys.reserve(occupied);
+  g.cellStart.reserve(occupied + 1);
+  g.primIds.reserve(references);
+  for (size_t i = 0; i < m.entries.size(); ++i) appendBrick(g, readBrick(path, m, i, whole.scene.boundedCount()));
+  sortCells(g);
   return whole;
 }
 
@@ -251,6 +250,8 @@ bool isGridSet(const std::string& path) {
   if (!in) fail<InputError>(path, ": cannot open");
   char magic[8] = {};
   in.read(magic, 8);
+  if (in.gcount() == 8 && std::memcmp(magic, kBrickMagic, 8) == 0)
+    fail<InputError>(path, ": a brick of a grid set, not a grid: open the set's manifest (NAME.vgrid beside NAME.bricks/)");
   return in.gcount() == 8 && std::memcmp(magic, kSetMagic, 8) == 0;
 }
 

@@ -1,12 +1,14 @@
-// Writing a grid set: each brick voxelized and written before the next starts (so one brick's cells are in memory at
-// a time), the manifest last (so a failure anywhere leaves no manifest).
-#include <cstring>
+// Writing a grid set: the scene file first, then each brick voxelized and written before the next starts (so one
+// brick's cells are in memory at a time), the fill's solid runs, the manifest last (so a failure anywhere leaves no
+// manifest).
+#include <algorithm>
 #include <filesystem>
 #include <system_error>
 
-#include "vox/core/error.h"
+#include "io/grid_set_header.h"
 #include "vox/io/atomic_file.h"
 #include "vox/io/grid_set.h"
+#include "vox/io/input_file.h"
 
 namespace vox {
 
@@ -16,10 +18,16 @@ std::string brickFolderName(const std::string& setPath) {
   return std::filesystem::path(setPath).stem().string() + ".bricks";
 }
 
-uint64_t headerChecksum(const std::string& fileBytes) {
-  uint64_t c = 0;
-  std::memcpy(&c, fileBytes.data() + 24, 8);  // docs/grid-format.md: the header's checksum field
-  return c;
+std::string besideManifest(const std::string& setPath, const std::string& file) {
+  return (std::filesystem::path(setPath).parent_path() / file).string();
+}
+
+Grid emptyPlan(const GridSetManifest& set) {
+  Grid g;
+  g.bounds = set.bounds;
+  g.dims = set.dims;
+  g.method = set.method;
+  return g;
 }
 
 }  // namespace
@@ -28,6 +36,8 @@ std::string brickFileName(const std::string& setPath, const std::array<uint32_t,
   return brickFolderName(setPath) + "/b_" + std::to_string(index[0]) + "_" + std::to_string(index[1]) + "_" +
          std::to_string(index[2]) + ".vgrid";
 }
+
+std::string sceneFileName(const std::string& setPath) { return brickFolderName(setPath) + "/scene.vgrid"; }
 
 void makeBrickFolder(const std::string& setPath) {
   const auto folder = std::filesystem::path(setPath).parent_path() / brickFolderName(setPath);
@@ -41,69 +51,122 @@ void makeBrickFolder(const std::string& setPath) {
                       ec ? ": " + ec.message() : std::string(": a file of that name is in the way"));
 }
 
-BrickEntry writeBrick(const std::string& setPath, const Scene& scene, const Grid& plan,
-                      const std::array<uint32_t, 3>& bricks, const std::array<uint32_t, 3>& index,
-                      std::span<const uint32_t> candidates, const VoxelizeOptions& options, VoxelizeStats* stats,
-                      bool writeEmpty) {
+GridSetScene writeGridSetScene(const std::string& setPath, const Scene& scene, const Grid& plan, bool write) {
+  Grid g;
+  g.bounds = plan.bounds;
+  g.dims = plan.dims;
+  g.method = plan.method;
+  g.outsidePrims = plan.outsidePrims;
+  const std::string bytes = encodeGridFile(scene, g);
+  GridSetScene s{sceneFileName(setPath), bytes.size(), headerChecksum(bytes)};
+  if (write) writeFileAtomically(besideManifest(setPath, s.file), bytes);
+  return s;
+}
+
+BrickEntry writeBrickFile(const std::string& setPath, const GridSetManifest& set, const std::array<uint32_t, 3>& index,
+                          const Grid& cells) {
+  BrickEntry e;
+  e.index = index;
+  e.file = brickFileName(setPath, index);
+  e.occupied = cells.occupiedCount();
+  e.references = cells.referenceCount();
+  e.solid = cells.solidCount();
+  const std::string bytes = encodeBrickFile(set, index, cells);
+  e.fileSize = bytes.size();
+  e.fileChecksum = headerChecksum(bytes);
+  writeFileAtomically(besideManifest(setPath, e.file), bytes);
+  return e;
+}
+
+BrickEntry writeBrick(const std::string& setPath, const GridSetManifest& set, const Scene& scene, const Grid& plan,
+                      const std::array<uint32_t, 3>& index, std::span<const uint32_t> candidates,
+                      const VoxelizeOptions& options, VoxelizeStats* stats) {
   VoxelizeStats brickStats;
-  const Grid grid = voxelizeBrick(scene, plan, brickWindow(plan.dims, bricks, index), candidates, options,
-                                  &brickStats);
+  const Grid grid =
+      voxelizeBrick(scene, plan, brickWindow(plan.dims, set.bricks, index), candidates, options, &brickStats);
   if (stats) {
     stats->cellsTested += brickStats.cellsTested;
     stats->exactFallbacks += brickStats.exactFallbacks;
     stats->seconds += brickStats.seconds;
   }
-  BrickEntry e;
-  e.index = index;
-  e.occupied = grid.occupiedCount();
-  e.references = grid.referenceCount();
-  if (e.occupied == 0 && !writeEmpty) return e;
-  e.file = brickFileName(setPath, index);
-  const std::string bytes = encodeGridFile(scene, grid);
-  e.fileSize = bytes.size();
-  e.fileChecksum = headerChecksum(bytes);
-  writeFileAtomically((std::filesystem::path(setPath).parent_path() / e.file).string(), bytes);
-  return e;
+  if (grid.occupiedCount() == 0) {
+    BrickEntry e;
+    e.index = index;
+    return e;
+  }
+  return writeBrickFile(setPath, set, index, grid);
+}
+
+FillReport fillGridSet(const std::string& setPath, GridSetManifest& set, const Scene& scene,
+                       const FillOptions& options) {
+  // The occupied cells of the whole grid, keys only: all that fillSolid reads of a grid besides its plan.
+  Grid keys = emptyPlan(set);
+  uint64_t occupied = 0;
+  for (const BrickEntry& e : set.entries) occupied += e.occupied;
+  if (double(occupied) * 8 > double(options.memoryLimitBytes))
+    fail<LimitError>("solid fill of a grid set of ", occupied, " occupied cells needs their keys, ", occupied >> 17,
+                     " MiB, more than the ", options.memoryLimitBytes >> 20, " MiB allowed");
+  keys.cellKeys.reserve(occupied);
+  for (size_t i = 0; i < set.entries.size(); ++i) {
+    const Grid brick = readBrick(setPath, set, i, scene.boundedCount());
+    keys.cellKeys.insert(keys.cellKeys.end(), brick.cellKeys.begin(), brick.cellKeys.end());
+  }
+  std::sort(keys.cellKeys.begin(), keys.cellKeys.end());
+  // The same keys, plan and scene as the single grid: fillSolid decides every run exactly as it does there.
+  const FillReport report = fillSolid(keys, scene, options);
+  std::vector<uint64_t>().swap(keys.cellKeys);
+  auto split = splitRunsByBrick(keys.solidRuns, set.dims, set.bricks);
+  std::vector<CellRun>().swap(keys.solidRuns);
+  // Bricks holding solid cells are rewritten with them (or written, when they hold no occupied cell).
+  std::vector<BrickEntry> entries;
+  size_t e = 0;
+  for (auto& [number, runs] : split) {
+    while (e < set.entries.size() && brickNumber(set.bricks, set.entries[e].index) < number)
+      entries.push_back(set.entries[e++]);
+    Grid cells = emptyPlan(set);
+    if (e < set.entries.size() && brickNumber(set.bricks, set.entries[e].index) == number)
+      cells = readBrick(setPath, set, e++, scene.boundedCount());
+    cells.solidRuns = std::move(runs);
+    entries.push_back(writeBrickFile(setPath, set, brickIndex(set.bricks, number), cells));
+  }
+  entries.insert(entries.end(), set.entries.begin() + ptrdiff_t(e), set.entries.end());
+  set.entries = std::move(entries);
+  return report;
 }
 
 void writeGridSetManifest(const std::string& setPath, const GridSetManifest& manifest) {
   GridSetManifest m = manifest;
-  std::erase_if(m.entries, [](const BrickEntry& e) { return e.occupied == 0; });
-  if (m.entries.empty()) {
-    for (const BrickEntry& e : manifest.entries)
-      if (!e.file.empty()) m.entries.push_back(e);
-    VOX_CHECK(m.entries.size() == 1);
-  }
+  std::erase_if(m.entries, [](const BrickEntry& e) { return e.occupied == 0 && e.solid == 0; });
+  std::sort(m.entries.begin(), m.entries.end(), [&](const BrickEntry& a, const BrickEntry& b) {
+    return brickNumber(m.bricks, a.index) < brickNumber(m.bricks, b.index);
+  });
   writeFileAtomically(setPath, encodeGridSetManifest(m));
 }
 
 GridSetManifest writeGridSet(const std::string& setPath, const Scene& scene, const VoxelizeOptions& options,
-                             const std::array<uint32_t, 3>& bricks, VoxelizeStats* stats) {
+                             const std::array<uint32_t, 3>& bricks, VoxelizeStats* stats, const FillOptions* fill,
+                             FillReport* fillReport) {
   Grid plan = planGrid(scene, options);
   checkBrickCounts(plan.dims, bricks);
   if (options.bounds) plan.outsidePrims = primitivesOutside(scene, plan);
   const auto candidates = brickCandidates(scene, plan, bricks, options.memoryLimitBytes);
   makeBrickFolder(setPath);
-  GridSetManifest m{plan.bounds, plan.dims, plan.method, bricks, {}};
+  GridSetManifest m{plan.bounds, plan.dims, plan.method, bricks, writeGridSetScene(setPath, scene, plan), {}};
   VoxelizeOptions brickOptions = options;
   brickOptions.progress = nullptr;
   for (uint64_t b = 0; b < candidates.size(); ++b) {
     if (options.progress && !options.progress(double(b) / double(candidates.size())))
       fail<Error>("voxelization cancelled");
     if (candidates[b].empty()) continue;
-    m.entries.push_back(writeBrick(setPath, scene, plan, bricks, brickIndex(bricks, b), candidates[b], brickOptions,
-                                   stats));
+    const BrickEntry e = writeBrick(setPath, m, scene, plan, brickIndex(bricks, b), candidates[b], brickOptions, stats);
+    if (e.occupied > 0) m.entries.push_back(e);
   }
-  bool any = false;
-  for (const BrickEntry& e : m.entries) any = any || e.occupied > 0;
-  // The scene lives in the brick files: a set without occupied cells still writes brick (0,0,0), empty.
-  if (!any) {
-    m.entries.clear();
-    m.entries.push_back(writeBrick(setPath, scene, plan, bricks, {0, 0, 0}, {}, brickOptions, stats, true));
+  if (options.progress) options.progress(1.0);
+  if (fill) {
+    const FillReport report = fillGridSet(setPath, m, scene, *fill);
+    if (fillReport) *fillReport = report;
   }
   writeGridSetManifest(setPath, m);
-  if (options.progress) options.progress(1.0);
-  std::erase_if(m.entries, [&](const BrickEntry& e) { return e.file.empty(); });
   return m;
 }
 

@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <cstdio>
 #include <map>
+#include <functional>
 #include <sstream>
+
+#include "vox/io/grid_set.h"
 
 namespace vox {
 
@@ -38,29 +41,57 @@ std::string jsonString(const std::string& s) {
   return out + "\"";
 }
 
+// Counts over the cells, added up block by block (a whole grid, or a set's layers of bricks in key order).
+struct CellTotals {
+  uint64_t occupied = 0, references = 0, solidCells = 0, solidRuns = 0;
+  std::map<size_t, size_t> histogram;  // primitives per cell -> cells
+  CellRun lastRun;
+
+  void add(const Grid& g) {
+    occupied += g.occupiedCount();
+    references += g.referenceCount();
+    for (size_t c = 0; c < g.occupiedCount(); ++c) ++histogram[g.cellStart[c + 1] - g.cellStart[c]];
+    // A set's layers each merge their runs; a run touching the previous layer's last is one run of the grid.
+    for (const CellRun& r : g.solidRuns) {
+      solidCells += r.count;
+      if (solidRuns > 0 && lastRun.first + lastRun.count == r.first) {
+        lastRun.count += r.count;
+      } else {
+        ++solidRuns;
+        lastRun = r;
+      }
+    }
+  }
+};
+
 struct Summary {
   size_t degenerate = 0;
   size_t ellipsoids = 0;
   uint64_t memoryBytes = 0;
-  std::map<size_t, size_t> histogram;  // primitives per cell -> cells
 };
 
-Summary summarize(const GridFile& file) {
+// What vox-info says about a grid: its scene, its plan (bounds, dims, method, outsidePrims) and its cells' totals.
+struct InfoSource {
+  const Scene& scene;
+  const Grid& plan;
+  const CellTotals& totals;
+};
+
+Summary summarize(const InfoSource& in) {
   Summary s;
-  for (const auto& t : file.scene.triangles) s.degenerate += isDegenerate(t);
-  for (const auto& sp : file.scene.spheres) s.ellipsoids += sp.isEllipsoid();
-  const Grid& g = file.grid;
-  s.memoryBytes = g.cellKeys.size() * 8 + g.cellStart.size() * 8 + g.primIds.size() * 4 + g.outsidePrims.size() * 4 +
-                  g.solidRuns.size() * 16;
-  for (size_t c = 0; c < g.occupiedCount(); ++c) ++s.histogram[g.cellStart[c + 1] - g.cellStart[c]];
+  for (const auto& t : in.scene.triangles) s.degenerate += isDegenerate(t);
+  for (const auto& sp : in.scene.spheres) s.ellipsoids += sp.isEllipsoid();
+  const CellTotals& c = in.totals;
+  s.memoryBytes = c.occupied * 8 + (c.occupied + 1) * 8 + c.references * 4 + in.plan.outsidePrims.size() * 4 +
+                  c.solidRuns * 16;
   return s;
 }
 
-std::string plain(const GridFile& file) {
-  const Grid& g = file.grid;
-  const Scene& sc = file.scene;
-  const Summary s = summarize(file);
-  std::ostringstream out;
+void plain(std::ostream& out, const InfoSource& in) {
+  const Grid& g = in.plan;
+  const Scene& sc = in.scene;
+  const CellTotals& t = in.totals;
+  const Summary s = summarize(in);
   out << "bounds: " << vec(g.bounds.lo) << " - " << vec(g.bounds.hi) << "\n";
   out << "dims: " << g.dims[0] << " x " << g.dims[1] << " x " << g.dims[2] << " (" << g.cellCount() << " cells)\n";
   out << "method: " << methodName(g.method) << "\n";
@@ -77,27 +108,27 @@ std::string plain(const GridFile& file) {
   out << "\n";
   out << "lights: " << sc.lights.size() << "\n";
   out << "camera: " << (sc.camera ? (sc.camera->kind == CameraKind::Perspective ? "perspective" : "orthographic") : "none") << "\n";
-  out << "occupied_cells: " << g.occupiedCount() << "\n";
-  out << "solid_cells: " << g.solidCount() << "\n";
-  out << "references: " << g.referenceCount() << "\n";
+  out << "occupied_cells: " << t.occupied << "\n";
+  out << "solid_cells: " << t.solidCells << "\n";
+  out << "references: " << t.references << "\n";
   out << "outside_primitives: " << g.outsidePrims.size() << "\n";
   out << "memory_bytes: " << s.memoryBytes << "\n";
   out << "primitives per occupied cell:\n";
   size_t maxCells = 1;
-  for (const auto& [k, n] : s.histogram) maxCells = std::max(maxCells, n);
-  for (const auto& [k, n] : s.histogram) {
+  for (const auto& [k, n] : t.histogram) maxCells = std::max(maxCells, n);
+  for (const auto& [k, n] : t.histogram) {
     char line[64];
     std::snprintf(line, sizeof line, "  %6zu: %10zu ", k, n);
     out << line << std::string(size_t(40.0 * double(n) / double(maxCells) + 0.5), '#') << "\n";
   }
-  return out.str();
 }
 
-std::string json(const GridFile& file, const InfoOptions& options) {
-  const Grid& g = file.grid;
-  const Scene& sc = file.scene;
-  const Summary s = summarize(file);
-  std::ostringstream out;
+// Everything before the cells.
+void jsonHead(std::ostream& out, const InfoSource& in) {
+  const Grid& g = in.plan;
+  const Scene& sc = in.scene;
+  const CellTotals& t = in.totals;
+  const Summary s = summarize(in);
   out << "{\n";
   out << "  \"bounds\": {\"min\": " << vec(g.bounds.lo) << ", \"max\": " << vec(g.bounds.hi) << "},\n";
   out << "  \"dims\": [" << g.dims[0] << ", " << g.dims[1] << ", " << g.dims[2] << "],\n";
@@ -105,9 +136,9 @@ std::string json(const GridFile& file, const InfoOptions& options) {
   out << "  \"primitive_counts\": {\"triangle\": " << sc.triangles.size() << ", \"sphere\": " << sc.spheres.size()
       << ", \"plane\": " << sc.planes.size() << ", \"degenerate_triangle\": " << s.degenerate
       << ", \"ellipsoid\": " << s.ellipsoids << "},\n";
-  out << "  \"occupied_cells\": " << g.occupiedCount() << ",\n";
-  out << "  \"solid_cells\": " << g.solidCount() << ",\n";
-  out << "  \"references\": " << g.referenceCount() << ",\n";
+  out << "  \"occupied_cells\": " << t.occupied << ",\n";
+  out << "  \"solid_cells\": " << t.solidCells << ",\n";
+  out << "  \"references\": " << t.references << ",\n";
   out << "  \"outside_primitives\": " << g.outsidePrims.size() << ",\n";
   out << "  \"memory_bytes\": " << s.memoryBytes << ",\n";
   // Solid textures by the material that uses them (the course's Checkerboard, Noise, Marble, Wood).
@@ -122,22 +153,30 @@ std::string json(const GridFile& file, const InfoOptions& options) {
   out << "],\n";
   out << "  \"histogram\": {";
   bool first = true;
-  for (const auto& [k, n] : s.histogram) {
+  for (const auto& [k, n] : t.histogram) {
     out << (first ? "" : ", ") << "\"" << k << "\": " << n;
     first = false;
   }
   out << "}";
-  if (options.cells) {
-    out << ",\n  \"cells\": [";
-    for (size_t c = 0; c < g.occupiedCount(); ++c) {
-      const auto ijk = cellIndex(g.dims, g.cellKeys[c]);
-      out << (c ? ",\n    " : "\n    ") << "{\"ijk\": [" << ijk[0] << ", " << ijk[1] << ", " << ijk[2] << "], \"prims\": [";
-      const auto prims = g.cellPrims(c);
-      for (size_t k = 0; k < prims.size(); ++k) out << (k ? ", " : "") << prims[k];
-      out << "]}";
-    }
-    out << "\n  ]";
+}
+
+// The cells of one block (in key order after the previous block's); `first`: no cell written yet.
+void jsonCells(std::ostream& out, const Grid& g, bool& first) {
+  std::string line;
+  for (size_t c = 0; c < g.occupiedCount(); ++c) {
+    const auto ijk = cellIndex(g.dims, g.cellKeys[c]);
+    line.assign(first ? "\n    " : ",\n    ");
+    first = false;
+    line += "{\"ijk\": [" + std::to_string(ijk[0]) + ", " + std::to_string(ijk[1]) + ", " + std::to_string(ijk[2]) +
+            "], \"prims\": [";
+    const auto prims = g.cellPrims(c);
+    for (size_t k = 0; k < prims.size(); ++k) (line += k ? ", " : "") += std::to_string(prims[k]);
+    line += "]}";
+    out << line;
   }
+}
+
+void jsonTail(std::ostream& out, const Scene& sc, const InfoOptions& options) {
   if (options.primitives) {
     out << ",\n  \"primitives\": [";
     size_t id = 0;
@@ -167,13 +206,42 @@ std::string json(const GridFile& file, const InfoOptions& options) {
     out << "\n  ]";
   }
   out << "\n}\n";
-  return out.str();
+}
+
+// The whole report; `forEachBlock(visit)` hands the cells over in key order, and is called once more for --cells.
+void writeInfo(std::ostream& out, const Scene& scene, const Grid& plan, const InfoOptions& options,
+               const std::function<void(const std::function<void(const Grid&)>&)>& forEachBlock) {
+  CellTotals totals;
+  forEachBlock([&](const Grid& block) { totals.add(block); });
+  const InfoSource in{scene, plan, totals};
+  if (!options.json) return plain(out, in);
+  jsonHead(out, in);
+  if (options.cells) {
+    out << ",\n  \"cells\": [";
+    bool first = true;
+    forEachBlock([&](const Grid& block) { jsonCells(out, block, first); });
+    out << "\n  ]";
+  }
+  jsonTail(out, scene, options);
 }
 
 }  // namespace
 
+void writeGridInfo(std::ostream& out, const GridFile& file, const InfoOptions& options) {
+  writeInfo(out, file.scene, file.grid, options, [&](const auto& visit) { visit(file.grid); });
+}
+
+void writeGridSetInfo(std::ostream& out, const std::string& setPath, const InfoOptions& options) {
+  const GridSetManifest m = readGridSetManifest(setPath);
+  const GridFile sceneFile = readGridSetScene(setPath, m);
+  writeInfo(out, sceneFile.scene, sceneFile.grid, options,
+            [&](const auto& visit) { forEachGridSetLayer(setPath, m, sceneFile, visit); });
+}
+
 std::string formatGridInfo(const GridFile& file, const InfoOptions& options) {
-  return options.json ? json(file, options) : plain(file);
+  std::ostringstream out;
+  writeGridInfo(out, file, options);
+  return out.str();
 }
 
 }  // namespace vox

@@ -1,5 +1,8 @@
 #include "vox/voxelize/bricks.h"
 
+#include <algorithm>
+#include <map>
+
 #include "vox/core/error.h"
 
 namespace vox {
@@ -82,6 +85,34 @@ std::vector<std::vector<uint32_t>> brickCandidates(const Scene& scene, const Gri
   for (uint64_t b = 0; b < brickCount; ++b) lists[b].reserve(counts[b]);
   forEachBrick([&](uint64_t b, uint32_t id) { lists[b].push_back(id); });
   return lists;
+}
+
+void appendSolidRun(std::vector<CellRun>& runs, const CellRun& run) {
+  if (!runs.empty() && runs.back().first + runs.back().count == run.first) runs.back().count += run.count;
+  else runs.push_back(run);
+}
+
+std::vector<std::pair<uint64_t, std::vector<CellRun>>> splitRunsByBrick(std::span<const CellRun> runs,
+                                                                        const std::array<uint32_t, 3>& dims,
+                                                                        const std::array<uint32_t, 3>& bricks) {
+  checkBrickCounts(dims, bricks);
+  const uint64_t nx = dims[0], ny = dims[1];
+  std::map<uint64_t, std::vector<CellRun>> byBrick;
+  for (const CellRun& run : runs) {
+    // A run may cross row ends (a row's last empty run and the next row's first): cut it into rows, then each
+    // row piece at the bricks' x boundaries.
+    for (uint64_t key = run.first, end = run.first + run.count; key < end;) {
+      const uint64_t row = key / nx, x0 = key % nx, x1 = std::min(nx, x0 + (end - key));
+      const uint32_t by = brickOfCell(row % ny, ny, bricks[1]), bz = brickOfCell(row / ny, dims[2], bricks[2]);
+      for (uint32_t bx = brickOfCell(x0, nx, bricks[0]); bx < bricks[0]; ++bx) {
+        const uint64_t lo = std::max(x0, nx * bx / bricks[0]), hi = std::min(x1, nx * (bx + 1) / bricks[0]);
+        if (lo >= hi) break;
+        appendSolidRun(byBrick[brickNumber(bricks, {bx, by, bz})], {row * nx + lo, hi - lo});
+      }
+      key = row * nx + x1;
+    }
+  }
+  return {std::make_move_iterator(byBrick.begin()), std::make_move_iterator(byBrick.end())};
 }
 
 }  // namespace vox

@@ -1,19 +1,32 @@
-// Grid sets (issue 13): one grid split into bricks of whole cells, one grid file per non-empty brick, named by a
-// small checksummed manifest. Layout in docs/grid-format.md "Grid sets".
+// Grid sets (issue 13): one grid split into bricks of whole cells. The scene is stored once, in a scene file; each
+// non-empty brick is a brick file holding only its cells, primitive lists and solid runs; a small checksummed
+// manifest names them all. Layout in docs/grid-format.md "Grid sets".
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "vox/io/grid_file.h"
 #include "vox/voxelize/bricks.h"
+#include "vox/voxelize/fill.h"
 #include "vox/voxelize/voxelize.h"
 
 namespace vox {
 
-inline constexpr uint32_t kGridSetVersion = 1;
+// Version 2: the scene in one scene file, bricks as brick files (version 1 put the whole scene in every brick).
+inline constexpr uint32_t kGridSetVersion = 2;
+inline constexpr uint32_t kBrickFileVersion = 1;
+
+// The set's scene file: a grid file holding the scene, the whole grid's bounds, dims, method and outsidePrims, and
+// no cells. Brick files name it and carry its checksum, so a brick is never read against another scene.
+struct GridSetScene {
+  std::string file;       // relative to the manifest's folder: "NAME.bricks/scene.vgrid"
+  uint64_t fileSize = 0;  // bytes of the scene file
+  uint64_t checksum = 0;  // the checksum in its header
+};
 
 // One written brick as the manifest lists it.
 struct BrickEntry {
@@ -23,63 +36,102 @@ struct BrickEntry {
   uint64_t fileChecksum = 0;               // the checksum in the brick file's header (ties the file to this set)
   uint64_t occupied = 0;                   // occupied cells of the brick
   uint64_t references = 0;                 // references of the brick
+  uint64_t solid = 0;                      // solid cells of the brick (--fill)
 };
 
-// What a manifest holds: the whole grid's plan (bounds, dims, method), the brick counts and the written bricks,
-// ascending by brick index (x fastest).
+// What a manifest holds: the whole grid's plan (bounds, dims, method), the brick counts, the scene file and the
+// written bricks, ascending by brick index (x fastest).
 struct GridSetManifest {
   Box bounds;
   std::array<uint32_t, 3> dims{1, 1, 1};
   OverlapMethod method = OverlapMethod::Exact;
   std::array<uint32_t, 3> bricks{1, 1, 1};
+  GridSetScene scene;
   std::vector<BrickEntry> entries;
 };
 
 // ---- Writing ----
 
-// The relative file name of a brick of the set at `setPath`: "NAME.bricks/b_X_Y_Z.vgrid" (NAME the manifest's
-// file name without its last extension).
+// The relative file names of a brick and of the scene file of the set at `setPath`: "NAME.bricks/b_X_Y_Z.vgrid"
+// and "NAME.bricks/scene.vgrid" (NAME the manifest's file name without its last extension).
 std::string brickFileName(const std::string& setPath, const std::array<uint32_t, 3>& index);
+std::string sceneFileName(const std::string& setPath);
 // Creates the folder the bricks of `setPath` go into (NAME.bricks beside it). Throws OutputError.
 void makeBrickFolder(const std::string& setPath);
 
-// Voxelizes brick `index` of the planned grid and, when it has occupied cells, writes its grid file (the whole
-// scene, the whole grid's bounds, dims and outsidePrims, the brick's cells with their whole-grid keys) beside the
-// manifest. Returns its entry; occupied == 0 means nothing was written (unless `writeEmpty`). Throws as voxelizeBrick and OutputError.
-BrickEntry writeBrick(const std::string& setPath, const Scene& scene, const Grid& plan,
-                      const std::array<uint32_t, 3>& bricks, const std::array<uint32_t, 3>& index,
-                      std::span<const uint32_t> candidates, const VoxelizeOptions& options,
-                      VoxelizeStats* stats = nullptr, bool writeEmpty = false);
+// Encodes the scene file of `scene` and the planned grid `plan` (bounds, dims, method, outsidePrims; its cells are
+// ignored) and, when `write`, writes it beside the manifest. Every process computes the same name, size and
+// checksum, so ranks that do not write it can still reference it. Throws OutputError.
+GridSetScene writeGridSetScene(const std::string& setPath, const Scene& scene, const Grid& plan, bool write = true);
 
-// Writes the manifest (atomically: a failure leaves no manifest). Entries with occupied == 0 are left out; a set
-// without any occupied cell still needs the scene, so `entries` must then hold brick (0,0,0), written anyway.
+// Writes brick `index` of `set` (plan, bricks and scene file taken from it) holding the cells and solid runs of
+// `cells` (whole-grid keys, all inside the brick). Returns its entry. Throws OutputError.
+BrickEntry writeBrickFile(const std::string& setPath, const GridSetManifest& set, const std::array<uint32_t, 3>& index,
+                          const Grid& cells);
+
+// Voxelizes brick `index` of the planned grid and, when it has occupied cells, writes its brick file. Returns its
+// entry; occupied == 0 means nothing was written. `set` gives the plan, the brick counts and the scene file.
+// Throws as voxelizeBrick and OutputError.
+BrickEntry writeBrick(const std::string& setPath, const GridSetManifest& set, const Scene& scene, const Grid& plan,
+                      const std::array<uint32_t, 3>& index, std::span<const uint32_t> candidates,
+                      const VoxelizeOptions& options, VoxelizeStats* stats = nullptr);
+
+// --fill for a set whose bricks are written: reads the bricks' occupied cells (8 bytes a cell, not their primitive
+// lists), fills them as fillSolid fills the single grid (so the solid cells are the single grid's), splits the
+// solid runs by brick and rewrites the bricks that hold solid cells (writing new ones for bricks holding only
+// solid cells). Updates set.entries (ascending). Throws as fillSolid, InputError for a corrupt brick, OutputError.
+FillReport fillGridSet(const std::string& setPath, GridSetManifest& set, const Scene& scene,
+                       const FillOptions& options);
+
+// Writes the manifest (atomically: a failure leaves no manifest). Entries without cells are left out.
 void writeGridSetManifest(const std::string& setPath, const GridSetManifest& manifest);
 
-// The whole job on one process: plan, candidates, each brick voxelized and written before the next starts, then the
-// manifest. `progress` (may be empty) gets the fraction of bricks done. Returns the manifest written.
+// The whole job on one process: plan, scene file, candidates, each brick voxelized and written before the next
+// starts, the fill when `fill` is given (its report in `fillReport`), then the manifest. `progress` (may be empty)
+// gets the fraction of bricks done. Returns the manifest written.
 GridSetManifest writeGridSet(const std::string& setPath, const Scene& scene, const VoxelizeOptions& options,
-                             const std::array<uint32_t, 3>& bricks, VoxelizeStats* stats = nullptr);
+                             const std::array<uint32_t, 3>& bricks, VoxelizeStats* stats = nullptr,
+                             const FillOptions* fill = nullptr, FillReport* fillReport = nullptr);
 
 // ---- Reading ----
 
 // Encoding of a manifest (docs/grid-format.md); decode checks magic, version, flags, size, checksum, every count,
-// brick indices (in range, strictly ascending), names (relative, inside the manifest's folder) and the totals.
+// brick indices (in range, strictly ascending), names and the totals. A version 1 manifest is refused with a
+// message saying to voxelize again.
 std::string encodeGridSetManifest(const GridSetManifest& manifest);
 GridSetManifest decodeGridSetManifest(const std::string& bytes, const std::string& name);
 GridSetManifest readGridSetManifest(const std::string& path);
 
-// Reads one brick of a set and checks it against the manifest: size and checksum as listed, the same bounds, dims
-// and method, every cell inside the brick, the counts as listed. Throws InputError naming the brick file.
-GridFile readBrick(const std::string& setPath, const GridSetManifest& manifest, size_t entry);
+// The set's scene file: size and checksum as listed, the manifest's bounds, dims and method, no cells. Returns the
+// scene and the grid without cells (bounds, dims, method, outsidePrims). Throws InputError naming the scene file.
+GridFile readGridSetScene(const std::string& setPath, const GridSetManifest& manifest);
 
-// The whole grid of a set in memory: the bricks' cells merged (they are disjoint and ordered by key within a
-// brick). Equal to the grid the single-process voxelizer makes. Throws InputError for a corrupt set, LimitError when
-// it cannot fit the memory budget.
+// Brick files: encoding and decoding (docs/grid-format.md "Brick file"). decodeBrickFile checks the header, that
+// the brick names the manifest's scene file with its checksum, the plan, the index, every cell and solid run inside
+// the brick, primitive ids below `boundedCount`, and the counts against `entry`. Throws InputError naming `name`.
+std::string encodeBrickFile(const GridSetManifest& set, const std::array<uint32_t, 3>& index, const Grid& cells);
+Grid decodeBrickFile(const std::string& bytes, const std::string& name, const GridSetManifest& set,
+                     const BrickEntry& entry, uint64_t boundedCount);
+
+// Reads one brick of a set: its file (inside the manifest's folder, size and checksum as listed) decoded as above,
+// primitive ids checked against the scene's `boundedCount` (Scene::boundedCount). Returns the brick's cells with
+// whole-grid keys (bounds, dims, method of the whole grid; no outsidePrims).
+Grid readBrick(const std::string& setPath, const GridSetManifest& manifest, size_t entry, uint64_t boundedCount);
+
+// Streams a set in cell-key order, one layer of bricks at a time (all bricks with one bz: cells are ordered x
+// fastest, so the cells of a layer's bricks interleave): `visit` gets each layer's cells and solid runs, sorted,
+// runs merged within the layer. Peak memory is one layer, not the grid. Throws as readBrick.
+void forEachGridSetLayer(const std::string& setPath, const GridSetManifest& manifest, const GridFile& sceneFile,
+                         const std::function<void(const Grid& layer)>& visit);
+
+// The whole grid of a set in memory: the bricks' cells merged. Equal to the grid the single-process voxelizer
+// makes. Throws InputError for a corrupt set, LimitError when it cannot fit the memory budget.
 GridFile readGridSet(const std::string& path);
 
 // Whether the file at `path` starts with the manifest's magic. Throws InputError when it cannot be read.
 bool isGridSet(const std::string& path);
-// readGridSet for a manifest, readGridFile otherwise: what the tools load.
+// readGridSet for a manifest, readGridFile otherwise: what the tools load. A brick file named directly is refused
+// with a message naming its manifest's role.
 GridFile readGridOrSet(const std::string& path);
 
 }  // namespace vox

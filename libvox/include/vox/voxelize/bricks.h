@@ -4,6 +4,8 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
+#include <utility>
 #include <vector>
 
 #include "vox/core/grid.h"
@@ -26,5 +28,15 @@ std::array<uint32_t, 3> brickIndex(const std::array<uint32_t, 3>& bricks, uint64
 // not fit.
 std::vector<std::vector<uint32_t>> brickCandidates(const Scene& scene, const Grid& plan,
                                                    const std::array<uint32_t, 3>& bricks, uint64_t memoryLimitBytes);
+
+// Appends `run` after sorted, non-overlapping runs, merging it with the last one when they touch.
+void appendSolidRun(std::vector<CellRun>& runs, const CellRun& run);
+
+// The solid runs of the whole grid (sorted, as Grid::solidRuns) split by brick: for each brick holding solid cells,
+// ascending by brickNumber, the runs clipped to it, sorted and merged where they touch. Merging every brick's runs
+// again (sort, appendSolidRun) gives back `runs` exactly.
+std::vector<std::pair<uint64_t, std::vector<CellRun>>> splitRunsByBrick(std::span<const CellRun> runs,
+                                                                        const std::array<uint32_t, 3>& dims,
+                                                                        const std::array<uint32_t, 3>& bricks);
 
 }  // namespace vox

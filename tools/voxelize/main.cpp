@@ -3,7 +3,7 @@
 #include <unistd.h>
 
 #include <chrono>
-#include <optional>
+#include <mutex>
 
 #include "../common/cli.h"
 #include "vox/io/atomic_file.h"
@@ -50,12 +50,13 @@ int runSet(const Options& opt, const vox::Scene& scene, vox::VoxelizeOptions vo,
   };
   VoxelizeStats stats;
   GridSetManifest set;
-  std::optional<ProgressBar> fillBar;
+  ProgressBar fillBar("filling", opt.common.quiet);
+  std::once_flag bricksDone;  // the fill calls progress from worker threads
   FillOptions fo;
   fo.memoryLimitBytes = vo.memoryLimitBytes;
   fo.progress = [&](double f) {
-    if (!fillBar) bar.finish(), fillBar.emplace("filling", opt.common.quiet);
-    fillBar->update(f);
+    std::call_once(bricksDone, [&] { bar.finish(); });
+    fillBar.update(f);
     return true;
   };
   FillReport report;
@@ -63,7 +64,7 @@ int runSet(const Options& opt, const vox::Scene& scene, vox::VoxelizeOptions vo,
     set = writeGridSet(opt.output, scene, vo, {opt.bricks[0], opt.bricks[1], opt.bricks[2]}, &stats,
                        opt.fill ? &fo : nullptr, &report);
     bar.finish();
-    if (fillBar) fillBar->finish();
+    fillBar.finish();
   } catch (const LimitError& e) {
     fail<LimitError>(opt.scene, ": ", e.what());
   } catch (const InputError& e) {

@@ -174,15 +174,16 @@ void appendBrick(Grid& whole, const Grid& brick) {
   whole.solidRuns.insert(whole.solidRuns.end(), brick.solidRuns.begin(), brick.solidRuns.end());
 }
 
-// Cells sorted by key (bricks side by side along x or y interleave), solid runs sorted and merged where they touch.
-void sortCells(Grid& grid) {
+// Solid runs sorted and merged where they touch; with `cells`, cells sorted by key (bricks side by side along x or y
+// interleave).
+void sortLayer(Grid& grid, bool cells = true) {
   std::sort(grid.solidRuns.begin(), grid.solidRuns.end(),
             [](const CellRun& a, const CellRun& b) { return a.first < b.first; });
   std::vector<CellRun> runs;
   runs.reserve(grid.solidRuns.size());
   for (const CellRun& r : grid.solidRuns) appendSolidRun(runs, r);
   grid.solidRuns = std::move(runs);
-  if (std::is_sorted(grid.cellKeys.begin(), grid.cellKeys.end())) return;
+  if (!cells || std::is_sorted(grid.cellKeys.begin(), grid.cellKeys.end())) return;
   const size_t n = grid.occupiedCount();
   std::vector<uint32_t> order(n);
   for (size_t c = 0; c < n; ++c) order[c] = uint32_t(c);
@@ -213,14 +214,14 @@ Grid emptyLike(const Grid& plan) {
 }  // namespace
 
 void forEachGridSetLayer(const std::string& setPath, const GridSetManifest& m, const GridFile& sceneFile,
-                         const std::function<void(const Grid& layer)>& visit) {
+                         const std::function<void(const Grid& layer)>& visit, bool sortCells) {
   size_t i = 0;
   for (uint32_t bz = 0; bz < m.bricks[2]; ++bz) {
     Grid layer = emptyLike(sceneFile.grid);
     for (; i < m.entries.size() && m.entries[i].index[2] == bz; ++i)
       appendBrick(layer, readBrick(setPath, m, i, sceneFile.scene.boundedCount()));
     if (layer.cellKeys.size() > UINT32_MAX) fail<LimitError>(setPath, ": a layer of bricks holds more than 2^32 cells");
-    sortCells(layer);
+    sortLayer(layer, sortCells);
     visit(layer);
   }
 }
@@ -240,7 +241,7 @@ GridFile readGridSet(const std::string& path) {
   g.cellStart.reserve(occupied + 1);
   g.primIds.reserve(references);
   for (size_t i = 0; i < m.entries.size(); ++i) appendBrick(g, readBrick(path, m, i, whole.scene.boundedCount()));
-  sortCells(g);
+  sortLayer(g);
   return whole;
 }
 

@@ -208,18 +208,20 @@ void jsonTail(std::ostream& out, const Scene& sc, const InfoOptions& options) {
   out << "\n}\n";
 }
 
-// The whole report; `forEachBlock(visit)` hands the cells over in key order, and is called once more for --cells.
+// The whole report; `forEachBlock(visit, ordered)` hands the cells over (in key order when `ordered`: the totals
+// need no order), once for the totals and once more for --cells.
+using BlockSource = std::function<void(const std::function<void(const Grid&)>&, bool ordered)>;
 void writeInfo(std::ostream& out, const Scene& scene, const Grid& plan, const InfoOptions& options,
-               const std::function<void(const std::function<void(const Grid&)>&)>& forEachBlock) {
+               const BlockSource& forEachBlock) {
   CellTotals totals;
-  forEachBlock([&](const Grid& block) { totals.add(block); });
+  forEachBlock([&](const Grid& block) { totals.add(block); }, false);
   const InfoSource in{scene, plan, totals};
   if (!options.json) return plain(out, in);
   jsonHead(out, in);
   if (options.cells) {
     out << ",\n  \"cells\": [";
     bool first = true;
-    forEachBlock([&](const Grid& block) { jsonCells(out, block, first); });
+    forEachBlock([&](const Grid& block) { jsonCells(out, block, first); }, true);
     out << "\n  ]";
   }
   jsonTail(out, scene, options);
@@ -228,14 +230,14 @@ void writeInfo(std::ostream& out, const Scene& scene, const Grid& plan, const In
 }  // namespace
 
 void writeGridInfo(std::ostream& out, const GridFile& file, const InfoOptions& options) {
-  writeInfo(out, file.scene, file.grid, options, [&](const auto& visit) { visit(file.grid); });
+  writeInfo(out, file.scene, file.grid, options, [&](const auto& visit, bool) { visit(file.grid); });
 }
 
 void writeGridSetInfo(std::ostream& out, const std::string& setPath, const InfoOptions& options) {
   const GridSetManifest m = readGridSetManifest(setPath);
   const GridFile sceneFile = readGridSetScene(setPath, m);
   writeInfo(out, sceneFile.scene, sceneFile.grid, options,
-            [&](const auto& visit) { forEachGridSetLayer(setPath, m, sceneFile, visit); });
+            [&](const auto& visit, bool ordered) { forEachGridSetLayer(setPath, m, sceneFile, visit, ordered); });
 }
 
 std::string formatGridInfo(const GridFile& file, const InfoOptions& options) {

@@ -120,9 +120,10 @@ Grid readBrick(const std::string& setPath, const GridSetManifest& manifest, size
 
 // Streams a set in cell-key order, one layer of bricks at a time (all bricks with one bz: cells are ordered x
 // fastest, so the cells of a layer's bricks interleave): `visit` gets each layer's cells and solid runs, sorted,
-// runs merged within the layer. Peak memory is one layer, not the grid. Throws as readBrick.
+// runs merged within the layer. Peak memory is one layer, not the grid. With `sortCells` false the cells come in
+// brick order (for totals, which need no order; the runs are still sorted). Throws as readBrick.
 void forEachGridSetLayer(const std::string& setPath, const GridSetManifest& manifest, const GridFile& sceneFile,
-                         const std::function<void(const Grid& layer)>& visit);
+                         const std::function<void(const Grid& layer)>& visit, bool sortCells = true);
 
 // The whole grid of a set in memory: the bricks' cells merged. Equal to the grid the single-process voxelizer
 // makes. Throws InputError for a corrupt set, LimitError when it cannot fit the memory budget.

@@ -4,6 +4,9 @@
 # Usage: bench/grid_set.sh BUILD_DIR WHAT...   with WHAT one of
 #   single:RES            vox-voxelize MESH --res RES
 #   set:RES:B             vox-voxelize MESH --res RES --bricks B B B
+#   fill:RES              vox-voxelize MESH --res RES --fill
+#   setfill:RES:B         vox-voxelize MESH --res RES --bricks B B B --fill
+#   info:RES[:B]          vox-info --json --cells of the single grid (or of the set of B^3 bricks) at RES
 #   mpi:RES:B:K           mpirun -n K vox-voxelize-mpi MESH --res RES --bricks B B B
 #   batch:N:RES:K         N meshes (made from the seed meshes, transformed) through vox-voxelize-mpi --batch
 # Environment: MESH (default the 69k bunny bun_zipper.ply), OUT (scratch folder, default /tmp/vox_bench_set; its
@@ -80,6 +83,12 @@ for what in "$@"; do
     single) measure "single $a^3" $T "$BIN/vox-voxelize" "$MESH" -o "$OUT/run.vgrid" --res "$a" --stats ;;
     set) measure "set $a^3, $b^3 bricks" $T "$BIN/vox-voxelize" "$MESH" -o "$OUT/run.vgrid" --res "$a" \
       --bricks "$b" "$b" "$b" --stats ;;
+    fill) measure "single $a^3 --fill" $T "$BIN/vox-voxelize" "$MESH" -o "$OUT/run.vgrid" --res "$a" --fill --stats ;;
+    setfill) measure "set $a^3, $b^3 bricks, --fill" $T "$BIN/vox-voxelize" "$MESH" -o "$OUT/run.vgrid" --res "$a" \
+      --bricks "$b" "$b" "$b" --fill --stats ;;
+    info) "$BIN/vox-voxelize" "$MESH" -o "$OUT/info.vgrid" --res "$a" ${b:+--bricks $b $b $b} -q
+      measure "vox-info --json --cells, $a^3${b:+, $b^3 bricks}" $T "$BIN/vox-info" "$OUT/info.vgrid" --json --cells
+      rm -rf "$OUT/info.vgrid" "$OUT/info.bricks" ;;
     mpi) measure "mpi K=$c, $a^3, $b^3 bricks" mpirun --oversubscribe -n "$c" $T "$BIN/vox-voxelize-mpi" "$MESH" \
       -o "$OUT/run.vgrid" --res "$a" --bricks "$b" "$b" "$b" --stats ;;
     batch) make_batch "$a"

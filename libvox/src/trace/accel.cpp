@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "trace/float_filter.h"
 #include "vox/core/error.h"
 
 namespace vox {
@@ -137,6 +138,7 @@ Accel buildAccel(const Scene& scene, const Grid& grid, AccelKind kind) {
     for (size_t r = 0; r < grid.primIds.size(); ++r)
       if (grid.primIds[r] < accel.triangleCount) accel.cellTriangles[r] = accel.triangles[grid.primIds[r]];
   }
+  if (kind == AccelKind::Grid) filter::buildFloatCells(accel, grid, kMaxCellTriangleBytes);
   return accel;
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "trace/float_filter.h"
 #include "trace/mailbox.h"
 
 namespace vox {
@@ -208,6 +209,61 @@ inline void consider(const Accel& accel, uint32_t id, const Ray& ray, Hit& best,
   }
 }
 
+// Tests the primitives at grid->primIds[begin, end) in double, as the walk always did (through the mailbox); keeps
+// the nearest hit in `best`. An occlusion query (AnyHit) returns at its first hit; the return value says whether it
+// hit.
+template <bool AnyHit>
+inline bool testRefs(const Accel& accel, uint64_t begin, uint64_t end, const Ray& ray, Mailbox<64>& mailbox,
+                     Hit& best, TraceStats& st) {
+  for (uint64_t r = begin; r < end; ++r) {
+    const uint32_t id = accel.grid->primIds[r];
+    if (mailbox.seen(id)) {
+      ++st.mailboxSkips;
+      continue;
+    }
+    ++st.tests;
+    double t;
+    if (intersectCellPrimitive(accel, r, id, ray, t) && closer(t, id, best)) {
+      best.t = t;
+      best.prim = id;
+      if (AnyHit) return true;
+    }
+  }
+  return false;
+}
+
+// The primitives of occupied cell c: its triangles through the float filter (float_filter.h), the few it cannot
+// reject, and any spheres after them, in double. The double test of a rejected triangle would have missed, so the
+// result is the one of testRefs over the whole cell.
+template <bool AnyHit>
+inline bool testCell(const Accel& accel, uint32_t c, const Ray& ray, const filter::FilterRay* fr, Mailbox<64>& mailbox,
+                     Hit& best, TraceStats& st) {
+  const uint64_t begin = accel.grid->cellStart[c];
+  if (!fr) return testRefs<AnyHit>(accel, begin, accel.grid->cellStart[c + 1], ray, mailbox, best, st);
+  const FloatCells::Cell cell = accel.floatCells.cells[c];
+  const TriangleGroup4* g = accel.floatCells.groups.data() + cell.first;
+  for (uint32_t k = 0; k < cell.count; k += 4, ++g) {
+    uint32_t maybe = filter::maybeHits(*g, *fr, std::min<uint32_t>(cell.count - k, 4));
+    st.filtered += std::min<uint32_t>(cell.count - k, 4) - uint32_t(__builtin_popcount(maybe));
+    for (; maybe != 0; maybe &= maybe - 1) {
+      const uint32_t id = g->id[__builtin_ctz(maybe)];
+      if (mailbox.seen(id)) {
+        ++st.mailboxSkips;
+        continue;
+      }
+      ++st.tests;
+      double t;
+      if (intersectTriangle(accel.triangles[id], ray, t) && closer(t, id, best)) {
+        best.t = t;
+        best.prim = id;
+        if (AnyHit) return true;
+      }
+    }
+  }
+  if (accel.sphereCount == 0) return false;
+  return testRefs<AnyHit>(accel, begin + cell.count, accel.grid->cellStart[c + 1], ray, mailbox, best, st);
+}
+
 }  // namespace
 
 Hit traceRay(const Accel& accel, const Ray& ray, TraceStats* stats) {
@@ -219,28 +275,15 @@ Hit traceRay(const Accel& accel, const Ray& ray, TraceStats* stats) {
     for (uint32_t id = 0; id < n; ++id) consider(accel, id, ray, best, st);
   } else {
     for (uint32_t id : accel.alwaysTested) consider(accel, id, ray, best, st);
+    filter::FilterRay filterRay;
+    const filter::FilterRay* fr = filter::prepareFilterRay(accel.floatCells, ray, filterRay) ? &filterRay : nullptr;
     GridWalker walker(accel, ray);
     Mailbox<64> mailbox;
     WalkCell cell;
     while (walker.next(cell)) {
       ++st.cells;
       const uint32_t c = accel.lookup(cell.idx[0], cell.idx[1], cell.idx[2]);
-      if (c < kSolidCell) {
-        const uint64_t end = accel.grid->cellStart[c + 1];
-        for (uint64_t r = accel.grid->cellStart[c]; r < end; ++r) {
-          const uint32_t id = accel.grid->primIds[r];
-          if (mailbox.seen(id)) {
-            ++st.mailboxSkips;
-            continue;
-          }
-          ++st.tests;
-          double t;
-          if (intersectCellPrimitive(accel, r, id, ray, t) && closer(t, id, best)) {
-            best.t = t;
-            best.prim = id;
-          }
-        }
-      }
+      if (c < kSolidCell) testCell<false>(accel, c, ray, fr, mailbox, best, st);
       // A hit may lie beyond this cell (a primitive spanning cells): it is kept, and accepted only once the walk
       // has passed every cell that could hold a nearer one.
       if (best.valid() && best.t + walker.hitSlack(best.t) < cell.tExit - cell.exitSlack) break;
@@ -266,26 +309,17 @@ bool occluded(const Accel& accel, const Ray& ray, TraceStats* stats) {
       ++st.tests;
       hit = intersectPrimitive(accel, accel.alwaysTested[i], ray, t);
     }
+    filter::FilterRay filterRay;
+    const filter::FilterRay* fr =
+        hit ? nullptr : filter::prepareFilterRay(accel.floatCells, ray, filterRay) ? &filterRay : nullptr;
     GridWalker walker(accel, ray);
     Mailbox<64> mailbox;
     WalkCell cell;
+    Hit any;
     while (!hit && walker.next(cell)) {
       ++st.cells;
       const uint32_t c = accel.lookup(cell.idx[0], cell.idx[1], cell.idx[2]);
-      if (c >= kSolidCell) continue;
-      const uint64_t end = accel.grid->cellStart[c + 1];
-      for (uint64_t r = accel.grid->cellStart[c]; r < end; ++r) {
-        const uint32_t id = accel.grid->primIds[r];
-        if (mailbox.seen(id)) {
-          ++st.mailboxSkips;
-          continue;
-        }
-        ++st.tests;
-        if (intersectCellPrimitive(accel, r, id, ray, t)) {
-          hit = true;
-          break;
-        }
-      }
+      if (c < kSolidCell) hit = testCell<true>(accel, c, ray, fr, mailbox, any, st);
     }
   }
   if (stats) *stats += st;

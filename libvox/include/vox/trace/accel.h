@@ -32,6 +32,30 @@ struct CellBoundaries {
 };
 CellBoundaries makeCellBoundaries(const Box& bounds, const std::array<uint32_t, 3>& dims);
 
+// Single-precision copies of the occupied cells' triangles for the float filter of the single-ray walk
+// (trace/float_filter.h, issue 12): four triangles to a group in structure-of-arrays form, each cell's groups next to
+// each other in cell order. Coordinates are scaled: x' = (x - center) * scale (scale a power of two, so the double
+// values scale exactly), then rounded to float. The filter only rejects triangles that a proven bound says the double
+// test would miss; the rest go to that test, so hits stay bit for bit.
+struct TriangleGroup4 {
+  float lane[12][4];  // rows: v0 x y z, e1 x y z, e2 x y z, n x y z (n = e1 x e2 of the double data, scaled by scale^2)
+  uint32_t id[4];     // triangle ids (lanes past the cell's count are unused)
+};
+struct FloatCells {
+  bool enabled = false;  // false when the scene's scale or values are outside what the bound covers
+  Vec3 center;
+  double scale = 1;
+  // Upper bounds over every group, scaled units: |v0' - 0| (vertexMax), |e1'|, |e2'| (edgeMax), |n'| (normalMax).
+  std::array<double, 3> vertexMax{0, 0, 0}, edgeMax{0, 0, 0}, normalMax{0, 0, 0};
+  // Per occupied cell c: groups [first[c], first[c] + (count[c] + 3) / 4), count[c] triangles (the cell's leading
+  // triangle ids; spheres follow them in grid->primIds).
+  struct Cell {
+    uint32_t first, count;
+  };
+  std::vector<Cell> cells;
+  std::vector<TriangleGroup4> groups;
+};
+
 inline constexpr uint32_t kEmptyCell = 0xffffffffu;
 inline constexpr uint32_t kSolidCell = 0xfffffffeu;
 
@@ -60,6 +84,8 @@ struct Accel {
   // place each (a dependent cache miss per test for incoherent rays, issue 12); the same values, so the same t.
   // Empty when it would take more than kMaxCellTriangleBytes; walks then read `triangles` by id.
   std::vector<TriangleData> cellTriangles;
+  // The float copies of the cells' triangles for the single-ray walk (AccelKind::Grid; empty over the budget).
+  FloatCells floatCells;
 
   uint32_t primitiveCount() const { return triangleCount + sphereCount + planeCount; }
 

@@ -202,12 +202,14 @@ struct TraceStats {
   uint64_t cells = 0;         // cells visited by walks (empty ones included)
   uint64_t tests = 0;         // ray-primitive intersection tests
   uint64_t mailboxSkips = 0;  // tests saved because the primitive was already tested by this ray
+  uint64_t filtered = 0;      // triangles the float filter rejected without a test (trace/float_filter.h)
 
   TraceStats& operator+=(const TraceStats& o) {
     rays += o.rays;
     cells += o.cells;
     tests += o.tests;
     mailboxSkips += o.mailboxSkips;
+    filtered += o.filtered;
     return *this;
   }
 };

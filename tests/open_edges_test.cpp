@@ -1,7 +1,11 @@
 // Open edges: counted after welding equal positions, grouped into boundaries with the area of their cap.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <random>
+
 #include "vox/voxelize/open_edges.h"
+#include "vox/voxelize/winding_number.h"
 
 namespace vox {
 namespace {
@@ -45,6 +49,40 @@ TEST(OpenEdges, ClosedOpenAndNonManifold) {
   std::swap(flipped[1].v[1], flipped[1].v[2]);
   EXPECT_EQ(countOpenEdges(flipped), 0u);
   EXPECT_EQ(openBoundaries(flipped).size(), 1u);
+}
+
+// The caps close the mesh: with them every edge is balanced, and the winding number is an integer off the surface
+// (1 inside the capped box, 0 outside), whatever the holes, their orientation seams and repeated edges.
+void expectCapsClose(const std::vector<Triangle>& mesh, uint32_t seed) {
+  std::vector<Triangle> closed = mesh;
+  for (const OpenBoundary& b : openBoundaries(mesh)) closed.insert(closed.end(), b.cap.begin(), b.cap.end());
+  EXPECT_TRUE(openBoundaries(closed).empty());
+  EXPECT_EQ(countOpenEdges(closed), 0u);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-0.5, 1.5);
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 q{u(rng), u(rng), u(rng)};
+    const double w = windingNumberExact(closed, q);
+    EXPECT_NEAR(w, std::round(w), 1e-9) << q.x << " " << q.y << " " << q.z;
+  }
+}
+
+TEST(OpenEdges, CapsCloseTheMesh) {
+  auto open = cube();
+  open.erase(open.begin() + 2, open.begin() + 4);  // one hole
+  expectCapsClose(open, 1);
+  open.erase(open.begin() + 4, open.begin() + 6);  // two faces gone: one larger hole, not planar
+  expectCapsClose(open, 2);
+  auto flipped = cube();  // an orientation seam, and a face used twice
+  std::swap(flipped[0].v[1], flipped[0].v[2]);
+  std::swap(flipped[1].v[1], flipped[1].v[2]);
+  flipped.push_back(flipped[5]);
+  expectCapsClose(flipped, 3);
+  auto lone = cube();  // two disjoint holes on opposite faces
+  lone.erase(lone.begin(), lone.begin() + 4);  // z = 0 and z = 1
+  const auto b = openBoundaries(lone);
+  EXPECT_EQ(b.size(), 2u);
+  expectCapsClose(lone, 4);
 }
 
 }  // namespace

@@ -6,12 +6,16 @@
 #include <atomic>
 #include <numbers>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <sstream>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "vox/core/error.h"
 #include "vox/voxelize/open_edges.h"
+#include "vox/voxelize/overlap.h"
 #include "vox/voxelize/winding_number.h"
 
 namespace vox {
@@ -198,8 +202,14 @@ struct SceneWinding {
     // The fast value errs by about 1e-3 (winding_number.h); near the threshold it is recomputed more closely, so
     // that the decision is the exact one except where the exact value itself is within 1e-3 of the threshold.
     constexpr double kRefineMargin = 0.05, kRefineBeta = 8;
-    double w = windingNumber(tree, q);
-    if (std::abs(std::abs(w) - kWindingThreshold) < kRefineMargin) w = windingNumber(tree, q, kRefineBeta);
+    const double w = windingNumber(tree, q);
+    if (std::abs(std::abs(w) - kWindingThreshold) >= kRefineMargin) return w + inSpheres(q);
+    return windingNumber(tree, q, kRefineBeta) + inSpheres(q);
+  }
+  // The fast value alone: enough to round w + s to the integer k (HoleCaps).
+  double rough(const Vec3& q) const { return windingNumber(tree, q) + inSpheres(q); }
+  double inSpheres(const Vec3& q) const {
+    double w = 0;
     for (const Sphere& s : spheres) {
       const Vec3 p = s.isEllipsoid() ? transformPoint(s.transform, q) : q;
       const Vec3 d = p - s.center;
@@ -223,15 +233,11 @@ struct Piece {
   uint32_t lo = 1, hi = 0;
 };
 
-// Decides one empty run by winding number. Its cells meet no surface, so the winding number changes along it
-// continuously, and only near open edges: both end cells are evaluated; when they disagree the run is split where
-// the decision changes (bisection, assuming one crossing).
-Piece decideRun(const Grid& grid, const SceneWinding& winding, uint64_t rowBase, uint32_t lo, uint32_t hi,
-                uint64_t& queries) {
-  auto inside = [&](uint32_t x) {
-    ++queries;
-    return std::abs(winding.at(cellCentre(grid, rowBase + x))) >= kWindingThreshold;
-  };
+// Decides one empty run from `inside(x)`, a decision that changes along the run continuously (its cells meet no
+// surface): both end cells are evaluated; when they disagree the run is split where the decision changes
+// (bisection, assuming one crossing).
+template <typename Inside>
+Piece decideRun(uint32_t lo, uint32_t hi, const Inside& inside) {
   const bool a = inside(lo), b = lo == hi ? a : inside(hi);
   if (a == b) return a ? Piece{lo, hi} : Piece{};
   uint32_t l = lo, h = hi;  // inside(l) == a, inside(h) == b
@@ -242,36 +248,109 @@ Piece decideRun(const Grid& grid, const SceneWinding& winding, uint64_t rowBase,
   return a ? Piece{lo, l} : Piece{h, hi};
 }
 
-// Where runs may share one winding number. The winding number of a mesh with holes is that of the closed surface
-// made by capping each hole (an integer, constant between surfaces) minus the caps' own winding numbers. Cap each
-// boundary by the cone from its box centre (inside its box, OpenBoundary::capArea); seen from a distance d of that
-// box a cap's winding number is at most capArea / (4 pi d^2). Runs where the sum of these bounds is at most kFar,
-// joined face to face, have winding numbers within 2 kFar of each other: one evaluation decides a whole group when
-// it lies farther than 2 kFar from the threshold. Runs nearer the holes are evaluated one by one.
-struct Sharing {
+// The holes' caps. Cap each boundary of the mesh by the cone from its box centre (OpenBoundary::cap, inside that
+// box): the mesh with its caps is closed, so its winding number is an integer k, constant in each region that
+// neither the surface nor a cap crosses, and the mesh's own winding number is w = k - s, s the caps' winding number.
+// Empty runs whose boxes meet no cap, joined face to face, share k: one evaluation of w + s finds it for a whole
+// group. Each cap's |s| is at most capArea / (4 pi d^2) at a distance d from its box; where the sum of these bounds
+// stays under kByIntegerAlone (< 0.5), |k - s| >= 0.5 exactly when k != 0, so k alone decides. Nearer the holes the
+// runs are decided by k - s, s from the caps' own small tree; only runs that a cap crosses need w itself.
+struct HoleCaps {
   bool enabled = false;
   std::vector<OpenBoundary> boundaries;
-  static constexpr double kFar = 0.2;
+  std::vector<Triangle> triangles;  // every boundary's cap
+  WindingTree tree;                 // over `triangles`
+  static constexpr double kByIntegerAlone = 0.45;
   static constexpr size_t kMaxBoundaries = 64;  // more: a soup, where every run is evaluated
 
-  Sharing(const Scene& scene, bool leaky) {
-    // Gaps in a `center` surface join cells on both sides of it: no constant winding number between them.
+  HoleCaps(std::vector<OpenBoundary>&& openBoundaries, bool leaky) {
+    // Gaps in a `center` surface join cells on both sides of it: no constant k between them.
     if (leaky) return;
-    boundaries = openBoundaries(scene.triangles);
+    boundaries = std::move(openBoundaries);
     enabled = boundaries.size() <= kMaxBoundaries;
+    if (!enabled) return;
+    for (const OpenBoundary& b : boundaries) triangles.insert(triangles.end(), b.cap.begin(), b.cap.end());
+    tree = buildWindingTree(triangles);
   }
-  bool far(const Box& run) const {
-    double bound = 0;
+  // Bound on |s| over `run`; infinite when the run meets a boundary's box.
+  double bound(const Box& run) const {
+    double sum = 0;
     for (const OpenBoundary& b : boundaries) {
       double d2 = 0;
       for (int a = 0; a < 3; ++a) {
         const double gap = std::max({b.bounds.lo[a] - run.hi[a], run.lo[a] - b.bounds.hi[a], 0.0});
         d2 += gap * gap;
       }
-      if (d2 == 0) return false;
-      bound += b.capArea / (4 * std::numbers::pi * d2);
+      if (d2 == 0) return std::numeric_limits<double>::infinity();
+      sum += b.capArea / (4 * std::numbers::pi * d2);
     }
-    return bound <= kFar;
+    return sum;
+  }
+  // Whether a cap may meet the closed box `run` (sat never misses a contact).
+  bool meets(const Box& run) const {
+    for (const OpenBoundary& b : boundaries) {
+      if (!overlaps(b.bounds, run)) continue;
+      for (const Triangle& t : b.cap) {
+        const Box tb{minVec(minVec(t.v[0], t.v[1]), t.v[2]), maxVec(maxVec(t.v[0], t.v[1]), t.v[2])};
+        if (overlaps(tb, run) && triangleBoxSat(t, run)) return true;
+      }
+    }
+    return false;
+  }
+  // Where the line through p along `axis`, between `lo` and `hi` on that axis, crosses the caps: the position and
+  // the change of k when crossing towards +axis, sorted. The line's sample points lie at first + i * spacing. False
+  // when a crossing is too near a cap triangle's edge (the line may pass between two triangles of a fan) or a sample
+  // point (where s jumps) to be placed for sure: the caller then falls back to w itself.
+  bool crossings(int axis, const Vec3& p, double lo, double hi, double first, double spacing,
+                 std::vector<std::pair<double, int>>& out) const {
+    out.clear();
+    const int u = (axis + 1) % 3, v = (axis + 2) % 3;  // the normal's `axis` component is the orientation in (u, v)
+    Box line{p, p};
+    line.lo.at(axis) = lo, line.hi.at(axis) = hi;
+    for (const OpenBoundary& b : boundaries) {
+      if (!overlaps(b.bounds, line)) continue;
+      for (const Triangle& t : b.cap) {
+        // Orientations of p against the triangle's edges in the (u, v) plane, with a rounding bound (Shewchuk's
+        // orient2d bound is 3.3e-16 of the products' magnitude; ours is far looser).
+        double e[3], err[3];
+        for (int i = 0; i < 3; ++i) {
+          const Vec3 &m = t.v[i], &n = t.v[(i + 1) % 3];
+          const double l = (n[u] - m[u]) * (p[v] - m[v]), r = (n[v] - m[v]) * (p[u] - m[u]);
+          e[i] = l - r;
+          err[i] = 1e-12 * (std::abs(l) + std::abs(r));
+        }
+        bool pos = false, neg = false, unsure = false;
+        for (int i = 0; i < 3; ++i) {
+          if (e[i] > err[i]) pos = true;
+          else if (e[i] < -err[i]) neg = true;
+          else unsure = true;
+        }
+        if (pos && neg) continue;  // the line misses this triangle
+        if (unsure) return false;
+        // Barycentric weights: v[0] by the edge opposite to it (e[1]), v[1] by e[2], v[2] by e[0].
+        const double at = (e[1] * t.v[0][axis] + e[2] * t.v[1][axis] + e[0] * t.v[2][axis]) / (e[0] + e[1] + e[2]);
+        if (at < lo || at > hi) continue;
+        const double phase = (at - first) / spacing;
+        if (std::abs(phase - std::round(phase)) < 1e-6) return false;
+        // Crossing towards +axis takes the point from the triangle's back (s near +1/2) to its front (s near -1/2)
+        // when the normal points to +axis (pos), and w = k - s is continuous: k drops by one.
+        out.push_back({at, pos ? -1 : 1});
+      }
+    }
+    std::sort(out.begin(), out.end());
+    return true;
+  }
+  // The caps' winding number at q, close enough to decide |k - s| >= 0.5 as the exact value does.
+  double at(const Vec3& q, int64_t k) const {
+    constexpr double kRefineMargin = 0.05, kRefineBeta = 8;
+    const double s = windingNumber(tree, q);
+    if (std::abs(std::abs(double(k) - s) - kWindingThreshold) >= kRefineMargin) return s;
+    return windingNumber(tree, q, kRefineBeta);
+  }
+  static bool overlaps(const Box& a, const Box& b) {
+    for (int i = 0; i < 3; ++i)
+      if (a.hi[i] < b.lo[i] || b.hi[i] < a.lo[i]) return false;
+    return true;
   }
 };
 
@@ -283,92 +362,189 @@ Box runBox(const Grid& grid, uint64_t rowBase, const Interval& run) {
 }
 
 // Per slot: what the winding stage must do with it.
-enum SlotState : uint8_t { kNone = 0, kShared = 1, kDecided = 2 };
+enum SlotState : uint8_t { kNone = 0, kByInteger = 1, kByCaps = 2, kCrossed = 3, kDecided = 4 };
+constexpr int64_t kUnknown = std::numeric_limits<int64_t>::min();  // a group whose k could not be told
 
-// The solid part of every empty run of the listed rows: enclosed gaps whole; under the WindingNumber rule the other
-// runs by decideRun, or, far from every open edge, by one evaluation per face-connected group (Sharing). Returns the
-// winding numbers evaluated.
-uint64_t decideRuns(const Grid& grid, const Scene& scene, const RowTable& t, const std::vector<uint8_t>& enclosed,
-                    bool winding, const FillOptions& options, std::vector<Piece>& pieces) {
-  std::optional<SceneWinding> w;
-  std::optional<Sharing> sharing;
-  if (winding) w.emplace(scene), sharing.emplace(scene, grid.method == OverlapMethod::Center);
-  std::vector<uint8_t> state(pieces.size(), kNone);
-  std::atomic<uint64_t> done{0}, queries{0};
+// Runs each listed row's empty runs through `body(r, run, counts)` in parallel, with progress and cancellation.
+struct RowSweep {
+  const RowTable& t;
+  const Grid& grid;
+  const FillOptions& options;
+  std::atomic<uint64_t> done{0}, full{0}, caps{0};
   std::atomic<bool> cancelled{false};
-  const uint64_t steps = 2 * t.row.size();
-  auto forRows = [&](auto&& body) {
+
+  template <typename Body>
+  void operator()(const Body& body) {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, t.row.size(), 64), [&](const tbb::blocked_range<size_t>& range) {
       if (cancelled) return;
       std::vector<Interval> runs;
-      uint64_t evaluated = 0;
+      uint64_t counts[2] = {0, 0};  // full and cap evaluations
       for (size_t r = range.begin(); r < range.end(); ++r) {
         rowIntervals(t, grid, r, runs);
-        for (const Interval& run : runs) body(r, run, evaluated);
+        for (const Interval& run : runs) body(r, run, counts);
       }
-      queries += evaluated;
+      full += counts[0], caps += counts[1];
       const uint64_t finished = done += range.size();
-      if (options.progress && !options.progress(double(finished) / double(steps))) cancelled = true;
+      if (options.progress && !options.progress(double(finished) / double(2 * t.row.size()))) cancelled = true;
     });
     if (cancelled) fail<Error>("solid fill cancelled");
+  }
+};
+
+// k of each group of runs sharing it (HoleCaps), at the group's root slot: w + s at the root run's middle cell,
+// rounded; kUnknown when w + s lies too far from an integer to trust (a mesh whose boundary we misjudged).
+std::vector<int64_t> groupIntegers(const Grid& grid, const RowTable& t, const SceneWinding& w, const HoleCaps& caps,
+                                   const UnionFind& groups, const std::vector<uint8_t>& state, RowSweep& sweep) {
+  struct Root {
+    uint64_t slot, key;
   };
+  std::vector<Root> roots;
+  std::vector<Interval> runs;
   const uint64_t nx = grid.dims[0];
-  // Pass 1: enclosed gaps, and runs near open edges decided one by one; the others wait for their group.
-  forRows([&](size_t r, const Interval& run, uint64_t& evaluated) {
+  for (size_t r = 0; r < t.row.size(); ++r) {
+    rowIntervals(t, grid, r, runs);
+    for (const Interval& run : runs)
+      if ((state[run.slot] == kByInteger || state[run.slot] == kByCaps) && groups.findConst(run.slot) == run.slot)
+        roots.push_back({run.slot, t.row[r] * nx + run.lo + (run.hi - run.lo) / 2});
+  }
+  std::vector<int64_t> k(state.size(), kUnknown);
+  tbb::parallel_for(size_t(0), roots.size(), [&](size_t i) {
+    const Vec3 q = cellCentre(grid, roots[i].key);
+    const double v = w.rough(q) + windingNumberExact(caps.triangles, q);
+    if (std::abs(v - std::round(v)) <= 0.25) k[roots[i].slot] = int64_t(std::llround(v));
+  });
+  sweep.full += roots.size();
+  return k;
+}
+
+// The solid part of every empty run of the listed rows: enclosed gaps whole; under the WindingNumber rule the other
+// runs by their group's k (HoleCaps), by k minus the caps' winding number, or, where a cap crosses the run, by the
+// winding number itself. Returns the evaluations of the mesh's winding number and of the caps'.
+std::pair<uint64_t, uint64_t> decideRuns(const Grid& grid, const Scene& scene, std::vector<OpenBoundary>&& boundaries,
+                                         const RowTable& t,
+                                         const std::vector<uint8_t>& enclosed, bool winding,
+                                         const FillOptions& options, std::vector<Piece>& pieces) {
+  std::optional<SceneWinding> w;
+  std::optional<HoleCaps> caps;
+  if (winding) w.emplace(scene), caps.emplace(std::move(boundaries), grid.method == OverlapMethod::Center);
+  std::vector<uint8_t> state(pieces.size(), kNone);
+  RowSweep sweep{t, grid, options};
+  const uint64_t nx = grid.dims[0];
+  auto byWinding = [&](size_t r, const Interval& run, uint64_t* counts) {
+    return decideRun(run.lo, run.hi, [&](uint32_t x) {
+      ++counts[0];
+      return std::abs(w->at(cellCentre(grid, t.row[r] * nx + x))) >= kWindingThreshold;
+    });
+  };
+  // k at cell x of listed row r (centre `q`) from a face neighbour in the next or previous row along y or z, when
+  // that cell belongs to a cap-free run whose group's k is known; kUnknown otherwise.
+  auto neighbourK = [&](size_t r, uint32_t x, const Vec3& q, const std::vector<int64_t>& groupK,
+                        const UnionFind& groups) {
+    thread_local std::vector<Interval> near;
+    thread_local std::vector<std::pair<double, int>> cuts;
+    const uint64_t ny = grid.dims[1], id = t.row[r], j = id % ny, kz = id / ny;
+    for (int o = 0; o < 4; ++o) {
+      const int axis = o < 2 ? 1 : 2;
+      const bool up = o % 2;
+      if (up ? (axis == 1 ? j + 1 >= ny : kz + 1 >= grid.dims[2]) : (axis == 1 ? j == 0 : kz == 0)) continue;
+      const uint64_t step = axis == 1 ? 1 : ny, target = up ? id + step : id - step;
+      const auto it = std::lower_bound(t.row.begin(), t.row.end(), target);
+      if (it == t.row.end() || *it != target) continue;
+      rowIntervals(t, grid, size_t(it - t.row.begin()), near);
+      for (const Interval& other : near) {
+        if (other.lo > x || other.hi < x || (state[other.slot] != kByInteger && state[other.slot] != kByCaps)) continue;
+        const int64_t known = groupK[groups.findConst(other.slot)];
+        const Vec3 from = cellCentre(grid, target * nx + x);
+        const double lo = std::min(from[axis], q[axis]), hi = std::max(from[axis], q[axis]);
+        if (known == kUnknown || !caps->crossings(axis, q, lo, hi, lo, hi - lo, cuts)) break;
+        int64_t k = known;
+        for (const auto& cut : cuts) k += up ? -cut.second : cut.second;  // walking from `from` to q
+        return k;
+      }
+    }
+    return kUnknown;
+  };
+  // A run that a cap crosses: k at its first cell, then changed at each crossing; the cells decided by k - s.
+  // k at the first cell comes from a neighbouring row's cap-free run, across the crossings between the two cell
+  // centres, or else from one evaluation of w + s there.
+  auto crossedRun = [&](size_t r, const Interval& run, const Box& box, const std::vector<int64_t>& groupK,
+                        const UnionFind& groups, uint64_t* counts) {
+    thread_local std::vector<std::pair<double, int>> cuts;
+    const uint64_t rowBase = t.row[r] * nx;
+    const Vec3 first = cellCentre(grid, rowBase + run.lo);
+    const double width = cellBoundary(grid.bounds, grid.dims, 0, int64_t(run.lo) + 1) - box.lo.x;
+    if (!caps->crossings(0, first, box.lo.x, box.hi.x, first.x, width, cuts)) return byWinding(r, run, counts);
+    int64_t k0 = neighbourK(r, run.lo, first, groupK, groups);
+    if (k0 == kUnknown) {
+      ++counts[0];
+      const double v = w->rough(first) + windingNumber(caps->tree, first);
+      if (std::abs(v - std::round(v)) > 0.25) return byWinding(r, run, counts);
+      k0 = std::llround(v);
+    }
+    return decideRun(run.lo, run.hi, [&](uint32_t x) {
+      ++counts[1];
+      const Vec3 q = cellCentre(grid, rowBase + x);
+      int64_t k = k0;
+      for (const auto& [at, dk] : cuts)
+        if (first.x < at && at < q.x) k += dk;
+      return std::abs(double(k) - caps->at(q, k)) >= kWindingThreshold;
+    });
+  };
+  // Pass 1: enclosed gaps, and every run when there are no caps; the others wait for their group's k.
+  sweep([&](size_t r, const Interval& run, uint64_t* counts) {
     if (run.node && enclosed[run.node - 1] && !options.windingOnly) {
       pieces[run.slot] = {run.lo, run.hi};
       state[run.slot] = kDecided;
     } else if (winding) {
-      if (sharing->enabled && sharing->far(runBox(grid, t.row[r] * nx, run))) {
-        state[run.slot] = kShared;
-      } else {
-        pieces[run.slot] = decideRun(grid, *w, t.row[r] * nx, run.lo, run.hi, evaluated);
+      const Box box = runBox(grid, t.row[r] * nx, run);
+      if (!caps->enabled) {
+        pieces[run.slot] = byWinding(r, run, counts);
         state[run.slot] = kDecided;
+      } else {
+        state[run.slot] = caps->bound(box) <= HoleCaps::kByIntegerAlone ? kByInteger
+                          : caps->meets(box)                             ? kCrossed
+                                                                         : kByCaps;
       }
     }
   });
-  if (!winding || !sharing->enabled) return queries;
-  // Groups of shared runs, then one evaluation per group at its root run (the first cell of the group's root).
-  UnionFind groups = linkRuns(t, grid, [&](const Interval& run) { return state[run.slot] == kShared; });
-  struct Root {
-    uint64_t slot, key;  // key: the middle cell of the root run
-  };
-  std::vector<Root> roots;
-  std::vector<Interval> runs;
-  for (size_t r = 0; r < t.row.size(); ++r) {
-    rowIntervals(t, grid, r, runs);
-    for (const Interval& run : runs)
-      if (state[run.slot] == kShared && groups.findConst(run.slot) == run.slot)
-        roots.push_back({run.slot, t.row[r] * nx + run.lo + (run.hi - run.lo) / 2});
-  }
-  std::vector<int8_t> verdict(state.size(), -1);  // at roots: 1 inside, 0 outside, -1 too close to call
-  tbb::parallel_for(size_t(0), roots.size(), [&](size_t i) {
-    const double v = std::abs(w->at(cellCentre(grid, roots[i].key)));
-    if (std::abs(v - kWindingThreshold) > 2 * Sharing::kFar) verdict[roots[i].slot] = v >= kWindingThreshold;
+  if (!winding || !caps->enabled) return {sweep.full, sweep.caps};
+  const UnionFind groups =
+      linkRuns(t, grid, [&](const Interval& run) { return state[run.slot] == kByInteger || state[run.slot] == kByCaps; });
+  const std::vector<int64_t> k = groupIntegers(grid, t, *w, *caps, groups, state, sweep);
+  // Pass 2: the waiting runs, by k alone, by k - s, or by w itself when k could not be told.
+  sweep([&](size_t r, const Interval& run, uint64_t* counts) {
+    if (state[run.slot] == kCrossed) {
+      pieces[run.slot] = crossedRun(r, run, runBox(grid, t.row[r] * nx, run), k, groups, counts);
+      return;
+    }
+    if (state[run.slot] != kByInteger && state[run.slot] != kByCaps) return;
+    const int64_t kRun = k[groups.findConst(run.slot)];
+    if (kRun == kUnknown) {
+      pieces[run.slot] = byWinding(r, run, counts);
+    } else if (state[run.slot] == kByInteger) {
+      if (kRun != 0) pieces[run.slot] = {run.lo, run.hi};
+    } else {
+      pieces[run.slot] = decideRun(run.lo, run.hi, [&](uint32_t x) {
+        ++counts[1];
+        return std::abs(double(kRun) - caps->at(cellCentre(grid, t.row[r] * nx + x), kRun)) >= kWindingThreshold;
+      });
+    }
   });
-  queries += roots.size();
-  // Pass 2: a shared run takes its group's verdict, or is evaluated alone when the verdict was too close to call.
-  forRows([&](size_t r, const Interval& run, uint64_t& evaluated) {
-    if (state[run.slot] != kShared) return;
-    const int8_t v = verdict[groups.findConst(run.slot)];
-    if (v < 0) pieces[run.slot] = decideRun(grid, *w, t.row[r] * nx, run.lo, run.hi, evaluated);
-    else if (v == 1) pieces[run.slot] = {run.lo, run.hi};
-  });
-  return queries;
+  return {sweep.full, sweep.caps};
 }
-
 }  // namespace
 
 FillReport fillSolid(Grid& grid, const Scene& scene, const FillOptions& options) {
   FillReport report;
   report.emptyCells = grid.cellCount() - grid.occupiedCount();
   report.leakyMethod = grid.method == OverlapMethod::Center;
-  const double treeBytes = 400.0 * double(scene.triangles.size());  // tree, its build and the edge count
+  // The tree and its build, the edge weld, and the holes' caps (up to three triangles per triangle).
+  const double treeBytes = 640.0 * double(scene.triangles.size());
   if (treeBytes > double(options.memoryLimitBytes))
     fail<LimitError>("solid fill of ", scene.triangles.size(), " triangles needs about ",
                      uint64_t(treeBytes / (1 << 20)), " MiB of scratch memory, more than the ",
                      options.memoryLimitBytes >> 20, " MiB allowed");
-  report.openEdges = countOpenEdges(scene.triangles);
+  std::vector<OpenBoundary> boundaries = openBoundaries(scene.triangles, &report.openEdges, HoleCaps::kMaxBoundaries);
   report.rule = report.openEdges > 0 || report.leakyMethod ? FillRule::WindingNumber : FillRule::Enclosed;
   if (options.rule) report.rule = *options.rule;
 
@@ -393,9 +569,12 @@ FillReport fillSolid(Grid& grid, const Scene& scene, const FillOptions& options)
     return report;
   }
   std::vector<Piece> pieces(table.gaps.size() + 2 * table.row.size());
-  report.windingQueries = decideRuns(grid, scene, table, enclosed, report.rule == FillRule::WindingNumber, options,
-                                     pieces);
+  std::tie(report.windingQueries, report.capQueries) =
+      decideRuns(grid, scene, std::move(boundaries), table, enclosed, report.rule == FillRule::WindingNumber, options,
+                 pieces);
   grid.solidRuns.clear();
+  // Reserved once: growing a vector of millions of runs costs more in page faults than the loop itself.
+  grid.solidRuns.reserve(uint64_t(std::count_if(pieces.begin(), pieces.end(), [](Piece p) { return p.lo <= p.hi; })));
   for (size_t r = 0; r < table.row.size(); ++r) {
     const uint64_t base = table.row[r] * grid.dims[0];
     for (uint64_t s = firstSlot(table, r); s < firstSlot(table, r + 1); ++s) {
@@ -428,7 +607,9 @@ std::string describeFill(const FillReport& r) {
   if (r.openEdges > 0 && r.leakyMethod) out << "; ";
   if (r.leakyMethod) out << "method center leaves gaps in surfaces";
   out << "), " << r.solidCells << " solid cells (" << r.enclosedCells << " enclosed, " << r.windingCells
-      << " by winding number, " << r.windingQueries << " evaluations)";
+      << " by winding number, " << r.windingQueries << " evaluations";
+  if (r.capQueries > 0) out << ", " << r.capQueries << " of the hole caps alone";
+  out << ")";
   return out.str();
 }
 

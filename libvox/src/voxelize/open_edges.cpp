@@ -16,8 +16,9 @@ namespace {
 
 struct WeldedEdges {
   std::vector<uint64_t> open;  // (id a << 32 | id b), a < b: used by an odd number of triangles
-  // Edges used more often in one direction than in the other (by `second`): the oriented boundary. The same as
-  // `open` for a consistently oriented mesh; also the seams where the orientation flips.
+  // Edges used more often in one direction than in the other: the oriented boundary. `second` is the surplus, > 0
+  // when the edge is used more often from its smaller id to its larger. The same as `open` for a consistently
+  // oriented mesh; also the seams where the orientation flips.
   std::vector<std::pair<uint64_t, int>> unbalanced;
   std::vector<uint32_t> cornerOfId;  // a corner (3 * triangle + vertex) at each welded id
 };
@@ -55,7 +56,7 @@ WeldedEdges findOpenEdges(std::span<const Triangle> triangles) {
     int net = 0;
     for (; f < edges.size() && edges[f].first == edges[e].first; ++f) net += edges[f].second;
     if ((f - e) & 1) out.open.push_back(edges[e].first);
-    if (net != 0) out.unbalanced.push_back({edges[e].first, std::abs(net)});
+    if (net != 0) out.unbalanced.push_back({edges[e].first, net});
     e = f;
   }
   return out;
@@ -65,8 +66,9 @@ WeldedEdges findOpenEdges(std::span<const Triangle> triangles) {
 
 uint64_t countOpenEdges(std::span<const Triangle> triangles) { return findOpenEdges(triangles).open.size(); }
 
-std::vector<OpenBoundary> openBoundaries(std::span<const Triangle> triangles) {
+std::vector<OpenBoundary> openBoundaries(std::span<const Triangle> triangles, uint64_t* openEdges, size_t capLimit) {
   const WeldedEdges w = findOpenEdges(triangles);
+  if (openEdges) *openEdges = w.open.size();
   auto point = [&](uint64_t id) -> const Vec3& { return triangles[w.cornerOfId[id] / 3].v[w.cornerOfId[id] % 3]; };
   // Union-find over the welded ids that boundary edges touch.
   std::unordered_map<uint64_t, uint64_t> parent;
@@ -87,17 +89,21 @@ std::vector<OpenBoundary> openBoundaries(std::span<const Triangle> triangles) {
   for (const auto& [e, n] : w.unbalanced) {
     const Vec3 &p = point(e >> 32), &q = point(e & 0xffffffffu);
     auto [it, added] = index.try_emplace(find(e >> 32), out.size());
-    if (added) out.push_back({{p, p}, 0, 0, 0});
+    if (added) out.push_back({{p, p}, 0, 0, 0, {}});
     OpenBoundary& b = out[it->second];
     b.bounds.lo = minVec(minVec(b.bounds.lo, p), q);
     b.bounds.hi = maxVec(maxVec(b.bounds.hi, p), q);
-    b.length += n * length(q - p);
-    b.edges += uint64_t(n & 1);
+    b.length += std::abs(n) * length(q - p);
+    b.edges += uint64_t(std::abs(n) & 1);
   }
+  const bool capped = out.size() <= capLimit;
   for (const auto& [e, n] : w.unbalanced) {
     OpenBoundary& b = out[index.at(find(e >> 32))];
     const Vec3 c = (b.bounds.lo + b.bounds.hi) * 0.5;
-    b.capArea += 0.5 * n * length(cross(point(e >> 32) - c, point(e & 0xffffffffu) - c));
+    // The edge is used |n| more times from `from` to `to` than back: the cap uses it |n| times from `to` to `from`.
+    const Vec3 &from = point(n > 0 ? e >> 32 : e & 0xffffffffu), &to = point(n > 0 ? e & 0xffffffffu : e >> 32);
+    for (int copy = 0; capped && copy < std::abs(n); ++copy) b.cap.push_back({{c, to, from}});
+    b.capArea += 0.5 * std::abs(n) * length(cross(from - c, to - c));
   }
   return out;
 }

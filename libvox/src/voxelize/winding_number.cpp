@@ -1,5 +1,8 @@
 #include "vox/voxelize/winding_number.h"
 
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -40,28 +43,34 @@ void summarize(WindingTree::Node& n, const BuildInput& in) {
   }
 }
 
+// Nodes of the subtree over `count` triangles: known before building, so that subtrees can be built in parallel
+// into their own index ranges of the depth-first order.
+uint32_t subtreeNodes(uint32_t count) {
+  return count > kLeafSize ? 1 + subtreeNodes(count / 2) + subtreeNodes(count - count / 2) : 1;
+}
+
 // Median split on the longest axis of the centroids, depth first, so that a subtree is a contiguous node range.
-void buildNode(WindingTree& tree, BuildInput& in, std::vector<uint32_t>& order, uint32_t first, uint32_t count) {
-  const uint32_t index = uint32_t(tree.nodes.size());
-  tree.nodes.emplace_back();
-  if (count > kLeafSize) {
-    Vec3 lo = in.centroid[order[first]], hi = lo;
-    for (uint32_t t = first; t < first + count; ++t) {
-      lo = minVec(lo, in.centroid[order[t]]);
-      hi = maxVec(hi, in.centroid[order[t]]);
-    }
-    const Vec3 ext = hi - lo;
-    const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
-    const uint32_t half = count / 2;
-    std::nth_element(order.begin() + first, order.begin() + first + half, order.begin() + first + count,
-                     [&](uint32_t a, uint32_t b) { return in.centroid[a][axis] < in.centroid[b][axis]; });
-    buildNode(tree, in, order, first, half);
-    buildNode(tree, in, order, first + half, count - half);
-  }
+void buildNode(WindingTree& tree, const BuildInput& in, std::vector<uint32_t>& order, uint32_t first, uint32_t count,
+               uint32_t index) {
   WindingTree::Node& n = tree.nodes[index];
   n.first = first;
   n.count = count;
-  n.skip = uint32_t(tree.nodes.size());
+  n.skip = index + subtreeNodes(count);
+  if (count <= kLeafSize) return;
+  Vec3 lo = in.centroid[order[first]], hi = lo;
+  for (uint32_t t = first; t < first + count; ++t) {
+    lo = minVec(lo, in.centroid[order[t]]);
+    hi = maxVec(hi, in.centroid[order[t]]);
+  }
+  const Vec3 ext = hi - lo;
+  const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+  const uint32_t half = count / 2;
+  std::nth_element(order.begin() + first, order.begin() + first + half, order.begin() + first + count,
+                   [&](uint32_t a, uint32_t b) { return in.centroid[a][axis] < in.centroid[b][axis]; });
+  auto left = [&] { buildNode(tree, in, order, first, half, index + 1); };
+  auto right = [&] { buildNode(tree, in, order, first + half, count - half, index + 1 + subtreeNodes(half)); };
+  if (count < 4096) left(), right();
+  else tbb::parallel_invoke(left, right);
 }
 
 }  // namespace
@@ -90,8 +99,8 @@ WindingTree buildWindingTree(std::span<const Triangle> triangles) {
   for (uint32_t t = 0; t < n; ++t) in.centroid[t] = (triangles[t].v[0] + triangles[t].v[1] + triangles[t].v[2]) / 3.0;
   std::vector<uint32_t> order(n);
   std::iota(order.begin(), order.end(), 0u);
-  tree.nodes.reserve(2 * (n / kLeafSize + 1));
-  buildNode(tree, in, order, 0, n);
+  tree.nodes.resize(subtreeNodes(n));
+  buildNode(tree, in, order, 0, n, 0);
   // Triangles in tree order, then each node's expansion over its range.
   in.corners.resize(n);
   in.areaNormal.resize(n);
@@ -103,7 +112,7 @@ WindingTree buildWindingTree(std::span<const Triangle> triangles) {
     centroid[t] = in.centroid[order[t]];
   }
   in.centroid = std::move(centroid);
-  for (WindingTree::Node& node : tree.nodes) summarize(node, in);
+  tbb::parallel_for(size_t(0), tree.nodes.size(), [&](size_t i) { summarize(tree.nodes[i], in); });
   tree.corners = std::move(in.corners);
   return tree;
 }

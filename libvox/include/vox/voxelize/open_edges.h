@@ -2,6 +2,7 @@
 // for closed surfaces and by the winding number otherwise).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -26,9 +27,15 @@ struct OpenBoundary {
   // Area of the cone from the centre of `bounds` over its edges: a surface inside `bounds` that closes the hole.
   double capArea = 0;
   uint64_t edges = 0;  // of them open (odd use count)
+  // The triangles of that cone, oriented so that they use each boundary edge against the mesh's surplus: the mesh
+  // and the caps of all its boundaries form a closed surface, whose winding number is an integer between surfaces.
+  std::vector<Triangle> cap;
 };
 // The oriented boundary of `triangles` grouped into connected pieces. For a consistently oriented mesh the sum of
-// their `edges` is countOpenEdges. Same scratch memory.
-std::vector<OpenBoundary> openBoundaries(std::span<const Triangle> triangles);
+// their `edges` is countOpenEdges, which it also stores in *openEdges (one weld for both). The caps are built only
+// when there are at most capLimit boundaries (up to 3 triangles of 80 bytes per mesh triangle otherwise). Same
+// scratch memory, plus the caps.
+std::vector<OpenBoundary> openBoundaries(std::span<const Triangle> triangles, uint64_t* openEdges = nullptr,
+                                         size_t capLimit = SIZE_MAX);
 
 }  // namespace vox

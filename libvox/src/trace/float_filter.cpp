@@ -63,7 +63,8 @@ void buildFloatCells(Accel& accel, const Grid& grid, uint64_t maxBytes) {
     groupCount += (n + 3) / 4;
   }
   if (!std::isfinite(m) || !(m > 0) || !isFinite(fc.center)) return;
-  if (groupCount * sizeof(TriangleGroup4) + (cellCount + 1) * sizeof(FloatCells::Cell) > maxBytes ||
+  if (groupCount * sizeof(TriangleGroup4) + (cellCount + 1 + accel.cellSlots.size()) * sizeof(FloatCells::Cell) >
+          maxBytes ||
       groupCount >= std::numeric_limits<uint32_t>::max())
     return;
   const int e = scaleExponent(m);
@@ -75,6 +76,11 @@ void buildFloatCells(Accel& accel, const Grid& grid, uint64_t maxBytes) {
   fc.cells.push_back({uint32_t(fc.groups.size()), 0});
   for (int a = 0; a < 3; ++a)
     if (!std::isfinite(fc.normalMax[a]) || !std::isfinite(fc.vertexMax[a]) || !std::isfinite(fc.edgeMax[a])) return;
+  if (accel.blockShift != 0) {
+    fc.slots.resize(accel.cellSlots.size(), {0, 0});
+    for (size_t k = 0; k < accel.cellSlots.size(); ++k)
+      if (accel.cellSlots[k] < kSolidCell) fc.slots[k] = fc.cells[accel.cellSlots[k]];
+  }
   fc.enabled = true;
   accel.floatCells = std::move(fc);
 }

@@ -236,15 +236,14 @@ inline bool testRefs(const Accel& accel, uint64_t begin, uint64_t end, const Ray
 // reject, and any spheres after them, in double. The double test of a rejected triangle would have missed, so the
 // result is the one of testRefs over the whole cell.
 template <bool AnyHit>
-inline bool testCell(const Accel& accel, uint32_t c, const Ray& ray, const filter::FilterRay* fr, Mailbox<64>& mailbox,
-                     Hit& best, TraceStats& st) {
-  const uint64_t begin = accel.grid->cellStart[c];
-  if (!fr) return testRefs<AnyHit>(accel, begin, accel.grid->cellStart[c + 1], ray, mailbox, best, st);
-  const FloatCells::Cell cell = accel.floatCells.cells[c];
+inline bool testGroups(const Accel& accel, FloatCells::Cell cell, const Ray& ray, const filter::FilterRay& fr,
+                       Mailbox<64>& mailbox, Hit& best, TraceStats& st) {
   const TriangleGroup4* g = accel.floatCells.groups.data() + cell.first;
   for (uint32_t k = 0; k < cell.count; k += 4, ++g) {
-    uint32_t maybe = filter::maybeHits(*g, *fr, std::min<uint32_t>(cell.count - k, 4));
-    st.filtered += std::min<uint32_t>(cell.count - k, 4) - uint32_t(__builtin_popcount(maybe));
+    const uint32_t lanes = std::min<uint32_t>(cell.count - k, 4);
+    uint32_t maybe = filter::maybeHits(*g, fr, lanes);
+    // Bits set in a 4-bit value from a table of nibbles: __builtin_popcount is a library call without -mpopcnt.
+    st.filtered += lanes - uint32_t((0x4332322132212110ull >> (4 * maybe)) & 0xf);
     for (; maybe != 0; maybe &= maybe - 1) {
       const uint32_t id = g->id[__builtin_ctz(maybe)];
       if (mailbox.seen(id)) {
@@ -260,8 +259,24 @@ inline bool testCell(const Accel& accel, uint32_t c, const Ray& ray, const filte
       }
     }
   }
+  return false;
+}
+
+template <bool AnyHit>
+inline bool testCell(const Accel& accel, uint32_t c, const Ray& ray, const filter::FilterRay* fr, Mailbox<64>& mailbox,
+                     Hit& best, TraceStats& st) {
+  const uint64_t begin = accel.grid->cellStart[c];
+  if (!fr) return testRefs<AnyHit>(accel, begin, accel.grid->cellStart[c + 1], ray, mailbox, best, st);
+  const FloatCells::Cell cell = accel.floatCells.cells[c];
+  if (testGroups<AnyHit>(accel, cell, ray, *fr, mailbox, best, st)) return true;
   if (accel.sphereCount == 0) return false;
   return testRefs<AnyHit>(accel, begin + cell.count, accel.grid->cellStart[c + 1], ray, mailbox, best, st);
+}
+
+// The float groups of a walk's cell straight from the block tables (Accel::floatCell), when the scene has only
+// triangles in its cells (else testCell, through the occupied-cell index).
+inline bool directGroups(const Accel& accel, const filter::FilterRay* fr) {
+  return fr && accel.sphereCount == 0 && !accel.floatCells.slots.empty();
 }
 
 }  // namespace
@@ -277,13 +292,18 @@ Hit traceRay(const Accel& accel, const Ray& ray, TraceStats* stats) {
     for (uint32_t id : accel.alwaysTested) consider(accel, id, ray, best, st);
     filter::FilterRay filterRay;
     const filter::FilterRay* fr = filter::prepareFilterRay(accel.floatCells, ray, filterRay) ? &filterRay : nullptr;
+    const bool direct = directGroups(accel, fr);
     GridWalker walker(accel, ray);
     Mailbox<64> mailbox;
     WalkCell cell;
     while (walker.next(cell)) {
       ++st.cells;
-      const uint32_t c = accel.lookup(cell.idx[0], cell.idx[1], cell.idx[2]);
-      if (c < kSolidCell) testCell<false>(accel, c, ray, fr, mailbox, best, st);
+      if (direct) {
+        testGroups<false>(accel, accel.floatCell(cell.idx[0], cell.idx[1], cell.idx[2]), ray, *fr, mailbox, best, st);
+      } else {
+        const uint32_t c = accel.lookup(cell.idx[0], cell.idx[1], cell.idx[2]);
+        if (c < kSolidCell) testCell<false>(accel, c, ray, fr, mailbox, best, st);
+      }
       // A hit may lie beyond this cell (a primitive spanning cells): it is kept, and accepted only once the walk
       // has passed every cell that could hold a nearer one.
       if (best.valid() && best.t + walker.hitSlack(best.t) < cell.tExit - cell.exitSlack) break;
@@ -312,14 +332,19 @@ bool occluded(const Accel& accel, const Ray& ray, TraceStats* stats) {
     filter::FilterRay filterRay;
     const filter::FilterRay* fr =
         hit ? nullptr : filter::prepareFilterRay(accel.floatCells, ray, filterRay) ? &filterRay : nullptr;
+    const bool direct = directGroups(accel, fr);
     GridWalker walker(accel, ray);
     Mailbox<64> mailbox;
     WalkCell cell;
     Hit any;
     while (!hit && walker.next(cell)) {
       ++st.cells;
-      const uint32_t c = accel.lookup(cell.idx[0], cell.idx[1], cell.idx[2]);
-      if (c < kSolidCell) hit = testCell<true>(accel, c, ray, fr, mailbox, any, st);
+      if (direct) {
+        hit = testGroups<true>(accel, accel.floatCell(cell.idx[0], cell.idx[1], cell.idx[2]), ray, *fr, mailbox, any, st);
+      } else {
+        const uint32_t c = accel.lookup(cell.idx[0], cell.idx[1], cell.idx[2]);
+        if (c < kSolidCell) hit = testCell<true>(accel, c, ray, fr, mailbox, any, st);
+      }
     }
   }
   if (stats) *stats += st;

@@ -116,10 +116,12 @@ class GridWalker {
     out.extra = false;
     // The axis of the nearest next boundary (first of equals), without branches: which axis wins is data
     // dependent, and mispredicted branches cost more than the comparisons.
+    // GCC turns the selects of an int into a branch, so m is formed from the comparison bits (b2 ? 2 : b01).
     const double t0 = tNext_[0], t1 = tNext_[1], t2 = tNext_[2];
-    const int m01 = t1 < t0;
+    const int b01 = t1 < t0;
     const double t01 = t1 < t0 ? t1 : t0;
-    const int m = t2 < t01 ? 2 : m01;
+    const int b2 = t2 < t01;
+    const int m = b01 + 2 * b2 - (b01 & b2);
     const double tm = t2 < t01 ? t2 : t01;
     out.tExit = tm;
     out.exitSlack = ax_.tol[m] + kRel * std::fabs(tm);
@@ -142,8 +144,11 @@ class GridWalker {
     return ax_.crossing(a, b, org_[a], dir_[a]);
   }
   // Is the ray, at parameter tm, within tolerance of axis a's next boundary?
+  // Both conditions evaluated (no short circuit): the second is harmless for an infinite tNext_ and the branch
+  // would be mispredicted.
   bool near(int a, double tm) const {
-    return std::isfinite(tNext_[a]) && (tNext_[a] - tm) * std::fabs(dir_[a]) <= ax_.tolPos[a] + kRel * std::fabs(tm * dir_[a]);
+    return std::isfinite(tNext_[a]) &
+           ((tNext_[a] - tm) * std::fabs(dir_[a]) <= ax_.tolPos[a] + kRel * std::fabs(tm * dir_[a]));
   }
 
   void step(int m, double tm, const WalkCell& from) {
@@ -152,7 +157,7 @@ class GridWalker {
       return;
     }
     // Neighbours across boundaries that the ray passes within tolerance of at this step (edges and corners).
-    const int a1 = m == 0 ? 1 : 0, a2 = m == 2 ? 1 : 2;
+    const int a1 = m == 0, a2 = 2 - (m == 2);
     const bool n1 = near(a1, tm), n2 = near(a2, tm);
     if (n1 | n2) [[unlikely]]
       queueExtras(m, tm, from, n1, n2);
@@ -162,7 +167,7 @@ class GridWalker {
       return;
     }
     // Entering a new block: look whether it is empty before reporting its first cell.
-    if (blockSlot_ && (idx_[m] & blockMask()) == (step_[m] > 0 ? 0 : blockMask())) checkBlock_ = true;
+    checkBlock_ = (blockSlot_ != nullptr) & ((idx_[m] & blockMask()) == (step_[m] > 0 ? 0 : blockMask()));
     tCur_ = tm;
     entryAxis_ = m;
     tNext_[m] = nextT(m);

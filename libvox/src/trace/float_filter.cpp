@@ -3,6 +3,7 @@
 #include "trace/float_filter.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 
@@ -90,10 +91,11 @@ bool prepareFilterRay(const FloatCells& fc, const Ray& ray, FilterRay& out) {
   const Vec3& d = ray.direction;
   const double dMax = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
   if (!(dMax > 0) || !std::isfinite(dMax)) return false;
-  // Direction scaled by a power of two to [1, 2) in its largest component: U, V, D, W all scale alike.
-  int de = 0;
-  std::frexp(dMax, &de);
-  const double dScale = std::ldexp(1.0, 1 - de);
+  // Direction scaled by a power of two to [1, 2) in its largest component: U, V, D, W all scale alike. The power is
+  // read from the exponent bits (frexp and ldexp are library calls, per ray); subnormal or huge dMax skip the filter.
+  const int biased = int((std::bit_cast<uint64_t>(dMax) >> 52) & 0x7ff);
+  if (biased == 0 || biased >= 2046) return false;
+  const double dScale = std::bit_cast<double>(uint64_t(2046 - biased) << 52);  // 2^(1023 - biased)
   double S[3], ad[3];
   for (int a = 0; a < 3; ++a) {
     const double o = (ray.origin[a] - fc.center[a]) * fc.scale;

@@ -1,22 +1,8 @@
-// OpenImageIO bridge for decoding textures (texture_decode.h), OIIO 2.4 as
-// Debian 12 ships it. Quirks relied on:
-// - ImageInput::create(name, false, nullptr, proxy) picks the reader from the
-// name's extension only and opens
-//   nothing; a reader that does not support "ioproxy" would open a real file of
-//   that name, so it is refused before open. Every byte decoded is the
-//   caller's, already read through input_file.h (folder and size checks).
-// - open, read_image report failure by return value and geterror(); the JPEG
-// reader turns libjpeg's fatal errors
-//   into a failed read (its error manager longjmps back), it does not exit.
-// - the PNG reader leaves libpng's default error handler in place, which prints
-// "libpng error: ..." on stderr
-//   before OIIO reports the failure: the library must not print, so PNG chunks
-//   (lengths, CRCs, IEND) are checked here first, which refuses truncated and
-//   corrupted files before libpng sees them.
+// Texture decoding: the checks and the conversion here, OpenImageIO's reading in its module (io/oiio_module.h).
+// The PNG reader leaves libpng's default error handler in place, which prints "libpng error: ..." on stderr
+// before OIIO reports the failure: the library must not print, so PNG chunks (lengths, CRCs, IEND) are checked here
+// first, which refuses truncated and corrupted files before libpng sees them.
 #include "import/texture_decode.h"
-
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <array>
@@ -24,6 +10,7 @@
 #include <filesystem>
 #include <vector>
 
+#include "io/oiio_module.h"
 #include "vox/core/error.h"
 #include "vox/io/input_file.h"
 
@@ -86,8 +73,7 @@ void checkPngChunks(const std::string& bytes, const std::string& where) {
   }
 }
 
-std::string oiioError(const std::string& message) {
-  std::string m = message.empty() ? OIIO::geterror() : message;
+std::string oiioError(std::string m) {
   while (!m.empty() && (m.back() == '\n' || m.back() == ' ')) m.pop_back();
   return quoteInput(m.empty() ? std::string("unknown error") : m, 160);
 }
@@ -109,50 +95,44 @@ Texture decodeTexture(const std::string& bytes, const std::string& name, const s
   const std::string ext = formatExtension(bytes, name);
   if (ext.empty()) fail<InputError>(where, ": unknown image format (no known signature or extension)");
   if (ext == ".png") checkPngChunks(bytes, where);
-  const std::string fakeName = "texture" + ext;
-  OIIO::Filesystem::IOMemReader proxy(bytes.data(), bytes.size());
-  auto in = OIIO::ImageInput::create(fakeName, false, nullptr, &proxy);
-  if (!in) fail<InputError>(where, ": no image reader for '", quoteInput(ext), "' files: ", oiioError(""));
-  if (!in->supports("ioproxy")) fail<InputError>(where, ": '", quoteInput(ext), "' images cannot be read from memory");
-  in->set_ioproxy(&proxy);
-  // Colours as stored: OIIO would otherwise premultiply PNG's unassociated
-  // alpha, blackening transparent texels.
-  OIIO::ImageSpec config;
-  config.attribute("oiio:UnassociatedAlpha", 1);
-  OIIO::ImageSpec spec;
-  if (!in->open(fakeName, spec, config)) fail<InputError>(where, ": cannot decode image: ", oiioError(in->geterror()));
-  const int channels = spec.nchannels;
-  if (spec.width <= 0 || spec.height <= 0 || spec.width > int(kMaxTextureSide) || spec.height > int(kMaxTextureSide))
-    fail<InputError>(where, ": image size ", spec.width, "x", spec.height, " is not between 1 and ", kMaxTextureSide,
-                     " on each side");
-  if (spec.depth > 1) fail<InputError>(where, ": volume images are not textures");
-  if (channels < 1 || channels > 64) fail<InputError>(where, ": image has ", channels, " channels");
-  const size_t texels = size_t(spec.width) * size_t(spec.height);
-  const bool isFloat = spec.format.basetype == OIIO::TypeDesc::FLOAT || spec.format.basetype == OIIO::TypeDesc::HALF ||
-                       spec.format.basetype == OIIO::TypeDesc::DOUBLE;
-  const int keep = std::min(channels, 3);
-  checkMemory(double(texels) * keep * (isFloat ? 4 + 1 : 1) + double(texels) * 3, where, "decoding the image");
-
+  ImageShape shape;
+  int keep = 0;
+  auto accept = [&](const ImageShape& seen) {
+    shape = seen;
+    if (shape.width <= 0 || shape.height <= 0 || shape.width > int(kMaxTextureSide) ||
+        shape.height > int(kMaxTextureSide))
+      fail<InputError>(where, ": image size ", shape.width, "x", shape.height, " is not between 1 and ",
+                       kMaxTextureSide, " on each side");
+    if (shape.depth > 1) fail<InputError>(where, ": volume images are not textures");
+    if (shape.channels < 1 || shape.channels > 64) fail<InputError>(where, ": image has ", shape.channels, " channels");
+    const double texels = double(shape.width) * double(shape.height);
+    keep = std::min(shape.channels, 3);
+    checkMemory(texels * keep * (shape.isFloat ? 4 + 1 : 1) + texels * 3, where, "decoding the image");
+    return keep;
+  };
+  std::vector<uint8_t> pixels;
+  std::vector<float> linear;
+  std::string detail;
+  switch (oiioModule().decode(bytes, ext, accept, pixels, linear, detail)) {
+    case DecodeFailure::None:
+      break;
+    case DecodeFailure::NoReader:
+      fail<InputError>(where, ": no image reader for '", quoteInput(ext), "' files: ", oiioError(detail));
+    case DecodeFailure::NoMemoryReader:
+      fail<InputError>(where, ": '", quoteInput(ext), "' images cannot be read from memory");
+    case DecodeFailure::Corrupt:
+      fail<InputError>(where, ": cannot decode image: ", oiioError(detail));
+  }
   Texture tex;
   tex.name = name;
-  tex.width = uint32_t(spec.width);
-  tex.height = uint32_t(spec.height);
-  tex.rgb.resize(texels * 3);
-  std::vector<uint8_t> pixels;
-  if (isFloat) {
-    // Floating-point images hold linear light; textures store sRGB-encoded
-    // bytes.
-    std::vector<float> linear(texels * size_t(keep));
-    if (!in->read_image(0, 0, 0, keep, OIIO::TypeDesc::FLOAT, linear.data()))
-      fail<InputError>(where, ": cannot decode image: ", oiioError(in->geterror()));
+  tex.width = uint32_t(shape.width);
+  tex.height = uint32_t(shape.height);
+  tex.rgb.resize(size_t(shape.width) * size_t(shape.height) * 3);
+  if (shape.isFloat) {
+    // Floating-point images hold linear light; textures store sRGB-encoded bytes.
     pixels.resize(linear.size());
     for (size_t i = 0; i < linear.size(); ++i) pixels[i] = uint8_t(std::lround(linearToSrgb(linear[i]) * 255));
-  } else {
-    pixels.resize(texels * size_t(keep));
-    if (!in->read_image(0, 0, 0, keep, OIIO::TypeDesc::UINT8, pixels.data()))
-      fail<InputError>(where, ": cannot decode image: ", oiioError(in->geterror()));
   }
-  in->close();
   toRgb(pixels, keep, tex.rgb);
   return tex;
 }

@@ -885,20 +885,28 @@ TEST(ImportExact, CourseNumbersAndItsTriangleMeshObjComeBackBitForBit) {
 }
 
 TEST(ImportExact, ThreeThousandTriangleMeshInstancesLoadInLinearTime) {
-  // A reserve(size() + n) per instance made this quadratic (21 s for 1,000 instances).
+  // A reserve(size() + n) per instance made this quadratic (21 s for 1,000 instances). Not a timed test: ten times
+  // the instances must take well under a hundred times as long (linear: ten), each the fastest of three loads, so
+  // that a loaded machine slows both alike.
   TempDir dir;
   fs::copy_file(course("bunny_200.obj"), dir.file("bunny.obj"));
-  constexpr int kInstances = 3000;
-  std::string group = "Group { numObjects " + std::to_string(kInstances) + " MaterialIndex 0\n";
-  for (int i = 0; i < kInstances; ++i)
-    group += "Transform { Translate " + std::to_string(i) + " 0 0 TriangleMesh { obj_file bunny.obj } }\n";
-  const std::string path = dir.write("many.txt", courseScene(group + "}\n"));
-  const auto start = std::chrono::steady_clock::now();
-  const Scene s = loadScene(path);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  EXPECT_EQ(s.triangles.size(), size_t{200} * kInstances);
-  EXPECT_LT(seconds, 2.0);
-  std::printf("3000 TriangleMesh instances: %.3f s\n", seconds);
+  auto fastestLoad = [&](int instances) {
+    std::string group = "Group { numObjects " + std::to_string(instances) + " MaterialIndex 0\n";
+    for (int i = 0; i < instances; ++i)
+      group += "Transform { Translate " + std::to_string(i) + " 0 0 TriangleMesh { obj_file bunny.obj } }\n";
+    const std::string path = dir.write("many" + std::to_string(instances) + ".txt", courseScene(group + "}\n"));
+    double best = 1e9;
+    for (int run = 0; run < 3; ++run) {
+      const auto start = std::chrono::steady_clock::now();
+      const Scene s = loadScene(path);
+      best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+      EXPECT_EQ(s.triangles.size(), size_t{200} * size_t(instances));
+    }
+    return best;
+  };
+  const double small = fastestLoad(300), large = fastestLoad(3000);
+  EXPECT_LT(large, 30 * small + 0.01) << small << " s for 300 instances, " << large << " s for 3000";
+  std::printf("300 TriangleMesh instances: %.3f s, 3000: %.3f s\n", small, large);
 }
 
 // A PLY file of one triangle per 9 values, vertex x y z of `type`, in `format`.

@@ -141,7 +141,9 @@ start=${EPOCHREALTIME/./}
 run "GLB instancing 6e8 triangles" 2 20 "$BIN/vox-voxelize" "$T/scene/instanced.glb" -o "$T/inst.vgrid"
 expect_err "GLB instancing 6e8 triangles" "instanced.glb: instancing 600000000 triangles needs about [0-9]* MiB"
 micros=$((${EPOCHREALTIME/./} - start))
-[ "$micros" -lt 1500000 ] || { echo "FAIL GLB instancing refused after ${micros} us"; fails=$((fails + 1)); }
+# Refused from the counts, before any instance is built (building them takes minutes): a bound generous enough for a
+# loaded CI machine under the sanitizers, where 1.5 s failed.
+[ "$micros" -lt 8000000 ] || { echo "FAIL GLB instancing refused after ${micros} us"; fails=$((fails + 1)); }
 
 # --- course scenes: meshes only from the scene's folder; instancing bounded ---
 mkdir -p "$T/course/sub"

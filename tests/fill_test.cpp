@@ -25,20 +25,6 @@ constexpr bool kSanitized = false;
 
 std::string seed(const std::string& rel) { return std::string(VOX_SEED_DIR) + "/" + rel; }
 
-// A closed axis-aligned box surface [a, b]^3 of 12 outward-oriented triangles.
-Scene boxScene(double a, double b) {
-  Scene scene;
-  scene.materials.push_back({});
-  Vec3 p[8];
-  for (int c = 0; c < 8; ++c) p[c] = {(c & 1) ? b : a, (c & 2) ? b : a, (c & 4) ? b : a};
-  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& q : quads) {
-    scene.triangles.push_back({{p[q[0]], p[q[1]], p[q[2]]}});
-    scene.triangles.push_back({{p[q[0]], p[q[2]], p[q[3]]}});
-  }
-  return scene;
-}
-
 std::vector<uint8_t> solidMask(const Grid& g) {
   std::vector<uint8_t> mask(g.cellCount(), 0);
   for (const CellRun& r : g.solidRuns)
@@ -81,7 +67,7 @@ void expectRunsWellFormed(const Grid& g) {
 
 TEST(Fill, ClosedBoxInteriorIsSolid) {
   // Faces at 0.15 and 0.85 in [0, 1] with 10 cells: inside cells 1 and 8, so the interior is cells 2..7 per axis.
-  Scene scene = boxScene(0.15, 0.85);
+  Scene scene = testing::boxScene(0.15, 0.85);
   VoxelizeOptions opt;
   opt.bounds = Box{{0, 0, 0}, {1, 1, 1}};
   opt.dims = {10, 10, 10};
@@ -109,7 +95,7 @@ TEST(Fill, EnclosedRunsEqualDenseFloodFill) {
   for (uint32_t s = 0; s < 12; ++s) {
     Scene scene = testing::randomScene(900 + s, 40 + 10 * int(s), 6);
     scene.triangles.clear();  // closed surfaces only, so that the rule is the flood fill
-    const Scene box = boxScene(0.05 + 0.01 * s, 0.9);
+    const Scene box = testing::boxScene(0.05 + 0.01 * s, 0.9);
     scene.triangles = box.triangles;
     VoxelizeOptions opt;
     opt.dims = dims[s % std::size(dims)];
@@ -197,7 +183,7 @@ TEST(Fill, CourseBunnyWindingNumberEqualsFloodFill) {
 }
 
 TEST(Fill, OpenBoxIsReportedOpenAndFilledByWindingNumber) {
-  Scene scene = boxScene(0.15, 0.85);
+  Scene scene = testing::boxScene(0.15, 0.85);
   scene.triangles.resize(10);  // the last face (x = 0.85) removed: a large hole
   VoxelizeOptions opt;
   opt.bounds = Box{{0, 0, 0}, {1, 1, 1}};
@@ -310,7 +296,7 @@ TEST(Fill, HoleCapsDecideAsThePlainWindingNumber) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(0.05, 0.4);
   for (int round = 0; round < (kSanitized ? 3 : 10); ++round) {
-    Scene box = boxScene(u(rng), 1 - u(rng));
+    Scene box = testing::boxScene(u(rng), 1 - u(rng));
     const int face = int(rng() % 6);
     box.triangles.erase(box.triangles.begin() + 2 * face, box.triangles.begin() + 2 * face + 2);
     if (round % 2) box.triangles.erase(box.triangles.begin(), box.triangles.begin() + 1);  // a triangle's hole too
@@ -330,7 +316,7 @@ TEST(Fill, HoleCapsDecideAsThePlainWindingNumber) {
 
 TEST(Fill, SuspiciousResultsAreNamedAndBudgetIsChecked) {
   // User bounds wholly inside a closed box: no cell meets the surface and every cell is inside.
-  Scene scene = boxScene(0, 1);
+  Scene scene = testing::boxScene(0, 1);
   VoxelizeOptions opt;
   opt.bounds = Box{{0.4, 0.4, 0.4}, {0.6, 0.6, 0.6}};
   opt.dims = {4, 4, 4};

@@ -134,32 +134,18 @@ TEST(GridSet, NoManifestWhenABrickCannotBeWritten) {
   EXPECT_FALSE(std::filesystem::exists(path));
 }
 
-// A closed axis-aligned box surface [a, b]^3 of 12 outward-oriented triangles.
-Scene boxScene(double a, double b) {
-  Scene scene;
-  scene.materials.push_back({});
-  Vec3 p[8];
-  for (int c = 0; c < 8; ++c) p[c] = {(c & 1) ? b : a, (c & 2) ? b : a, (c & 4) ? b : a};
-  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& q : quads) {
-    scene.triangles.push_back({{p[q[0]], p[q[1]], p[q[2]]}});
-    scene.triangles.push_back({{p[q[0]], p[q[2]], p[q[3]]}});
-  }
-  return scene;
-}
-
 // --fill over a set gives the single grid's solid cells, run for run, for closed (flood) and open (winding number)
 // surfaces, spheres, and brick counts from one brick to bricks of one cell.
 TEST(GridSet, FillEqualsTheSingleGridsFill) {
   testing::ScratchDir dir("gridset_fill");
-  Scene open = boxScene(0.15, 0.85);
+  Scene open = testing::boxScene(0.15, 0.85);
   open.triangles.resize(10);  // the face x = 0.85 removed: a hole, decided by winding number
   Scene spheres;
   spheres.materials.push_back({});
   spheres.spheres.push_back({{0.35, 0.4, 0.5}, 0.25, {}, 0});
   spheres.spheres.push_back({{0.7, 0.6, 0.45}, 0.2, {}, 0});
-  Scene twoBoxes = boxScene(0.1, 0.45);
-  for (const Triangle& t : boxScene(0.5, 0.9).triangles) twoBoxes.triangles.push_back(t);
+  Scene twoBoxes = testing::boxScene(0.1, 0.45);
+  for (const Triangle& t : testing::boxScene(0.5, 0.9).triangles) twoBoxes.triangles.push_back(t);
   const Scene bunny = loadScene(std::string(VOX_SEED_DIR) + "/meshes/bun_zipper.ply");  // scanned, open
   struct Case {
     const char* name;
@@ -208,7 +194,7 @@ TEST(GridSet, FillEqualsTheSingleGridsFill) {
 // vox-info streams a set one layer of bricks at a time; its report is the single grid's, byte for byte.
 TEST(GridSet, StreamedInfoEqualsTheSingleGrids) {
   testing::ScratchDir dir("gridset_info");
-  const Scene scene = boxScene(0.1, 0.8);
+  const Scene scene = testing::boxScene(0.1, 0.8);
   VoxelizeOptions o;
   o.dims = std::array<uint32_t, 3>{9, 8, 7};
   o.bounds = Box{{0, 0, 0}, {1, 1, 1}};

@@ -32,6 +32,20 @@ class ScratchDir {
   std::filesystem::path path_;
 };
 
+// A closed axis-aligned box surface [a, b]^3 of 12 outward-oriented triangles.
+inline Scene boxScene(double a, double b) {
+  Scene scene;
+  scene.materials.push_back({});
+  Vec3 p[8];
+  for (int c = 0; c < 8; ++c) p[c] = {(c & 1) ? b : a, (c & 2) ? b : a, (c & 4) ? b : a};
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads) {
+    scene.triangles.push_back({{p[q[0]], p[q[1]], p[q[2]]}});
+    scene.triangles.push_back({{p[q[0]], p[q[2]], p[q[3]]}});
+  }
+  return scene;
+}
+
 // Random triangles (some degenerate, some tiny) and spheres (some ellipsoids) inside [lo, lo + size]^3.
 inline Scene randomScene(uint32_t seed, int triangles, int spheres, double lo = 0, double size = 1) {
   std::mt19937 rng(seed);

@@ -364,6 +364,8 @@ Box runBox(const Grid& grid, uint64_t rowBase, const Interval& run) {
 // Per slot: what the winding stage must do with it.
 enum SlotState : uint8_t { kNone = 0, kByInteger = 1, kByCaps = 2, kCrossed = 3, kDecided = 4 };
 constexpr int64_t kUnknown = std::numeric_limits<int64_t>::min();  // a group whose k could not be told
+// Whether a slot's run waits for its group's k (it meets no cap).
+bool sharesK(uint8_t state) { return state == kByInteger || state == kByCaps; }
 
 // Runs each listed row's empty runs through `body(r, run, counts)` in parallel, with progress and cancellation.
 struct RowSweep {
@@ -404,7 +406,7 @@ std::vector<int64_t> groupIntegers(const Grid& grid, const RowTable& t, const Sc
   for (size_t r = 0; r < t.row.size(); ++r) {
     rowIntervals(t, grid, r, runs);
     for (const Interval& run : runs)
-      if ((state[run.slot] == kByInteger || state[run.slot] == kByCaps) && groups.findConst(run.slot) == run.slot)
+      if (sharesK(state[run.slot]) && groups.findConst(run.slot) == run.slot)
         roots.push_back({run.slot, t.row[r] * nx + run.lo + (run.hi - run.lo) / 2});
   }
   std::vector<int64_t> k(state.size(), kUnknown);
@@ -417,12 +419,40 @@ std::vector<int64_t> groupIntegers(const Grid& grid, const RowTable& t, const Sc
   return k;
 }
 
+// k at cell x of listed row r (centre `q`) from a face neighbour in the next or previous row along y or z, when
+// that cell belongs to a cap-free run whose group's k is known; kUnknown otherwise.
+int64_t neighbourK(const Grid& grid, const RowTable& t, const HoleCaps& caps, const std::vector<uint8_t>& state,
+                   const std::vector<int64_t>& groupK, const UnionFind& groups, size_t r, uint32_t x, const Vec3& q) {
+  thread_local std::vector<Interval> near;
+  thread_local std::vector<std::pair<double, int>> cuts;
+  const uint64_t nx = grid.dims[0], ny = grid.dims[1], id = t.row[r], j = id % ny, kz = id / ny;
+  for (int o = 0; o < 4; ++o) {
+    const int axis = o < 2 ? 1 : 2;
+    const bool up = o % 2;
+    if (up ? (axis == 1 ? j + 1 >= ny : kz + 1 >= grid.dims[2]) : (axis == 1 ? j == 0 : kz == 0)) continue;
+    const uint64_t step = axis == 1 ? 1 : ny, target = up ? id + step : id - step;
+    const auto it = std::lower_bound(t.row.begin(), t.row.end(), target);
+    if (it == t.row.end() || *it != target) continue;
+    rowIntervals(t, grid, size_t(it - t.row.begin()), near);
+    for (const Interval& other : near) {
+      if (other.lo > x || other.hi < x || !sharesK(state[other.slot])) continue;
+      const int64_t known = groupK[groups.findConst(other.slot)];
+      const Vec3 from = cellCentre(grid, target * nx + x);
+      const double lo = std::min(from[axis], q[axis]), hi = std::max(from[axis], q[axis]);
+      if (known == kUnknown || !caps.crossings(axis, q, lo, hi, lo, hi - lo, cuts)) break;
+      int64_t k = known;
+      for (const auto& cut : cuts) k += up ? -cut.second : cut.second;  // walking from `from` to q
+      return k;
+    }
+  }
+  return kUnknown;
+}
+
 // The solid part of every empty run of the listed rows: enclosed gaps whole; under the WindingNumber rule the other
 // runs by their group's k (HoleCaps), by k minus the caps' winding number, or, where a cap crosses the run, by the
 // winding number itself. Returns the evaluations of the mesh's winding number and of the caps'.
 std::pair<uint64_t, uint64_t> decideRuns(const Grid& grid, const Scene& scene, std::vector<OpenBoundary>&& boundaries,
-                                         const RowTable& t,
-                                         const std::vector<uint8_t>& enclosed, bool winding,
+                                         const RowTable& t, const std::vector<uint8_t>& enclosed, bool winding,
                                          const FillOptions& options, std::vector<Piece>& pieces) {
   std::optional<SceneWinding> w;
   std::optional<HoleCaps> caps;
@@ -436,34 +466,6 @@ std::pair<uint64_t, uint64_t> decideRuns(const Grid& grid, const Scene& scene, s
       return std::abs(w->at(cellCentre(grid, t.row[r] * nx + x))) >= kWindingThreshold;
     });
   };
-  // k at cell x of listed row r (centre `q`) from a face neighbour in the next or previous row along y or z, when
-  // that cell belongs to a cap-free run whose group's k is known; kUnknown otherwise.
-  auto neighbourK = [&](size_t r, uint32_t x, const Vec3& q, const std::vector<int64_t>& groupK,
-                        const UnionFind& groups) {
-    thread_local std::vector<Interval> near;
-    thread_local std::vector<std::pair<double, int>> cuts;
-    const uint64_t ny = grid.dims[1], id = t.row[r], j = id % ny, kz = id / ny;
-    for (int o = 0; o < 4; ++o) {
-      const int axis = o < 2 ? 1 : 2;
-      const bool up = o % 2;
-      if (up ? (axis == 1 ? j + 1 >= ny : kz + 1 >= grid.dims[2]) : (axis == 1 ? j == 0 : kz == 0)) continue;
-      const uint64_t step = axis == 1 ? 1 : ny, target = up ? id + step : id - step;
-      const auto it = std::lower_bound(t.row.begin(), t.row.end(), target);
-      if (it == t.row.end() || *it != target) continue;
-      rowIntervals(t, grid, size_t(it - t.row.begin()), near);
-      for (const Interval& other : near) {
-        if (other.lo > x || other.hi < x || (state[other.slot] != kByInteger && state[other.slot] != kByCaps)) continue;
-        const int64_t known = groupK[groups.findConst(other.slot)];
-        const Vec3 from = cellCentre(grid, target * nx + x);
-        const double lo = std::min(from[axis], q[axis]), hi = std::max(from[axis], q[axis]);
-        if (known == kUnknown || !caps->crossings(axis, q, lo, hi, lo, hi - lo, cuts)) break;
-        int64_t k = known;
-        for (const auto& cut : cuts) k += up ? -cut.second : cut.second;  // walking from `from` to q
-        return k;
-      }
-    }
-    return kUnknown;
-  };
   // A run that a cap crosses: k at its first cell, then changed at each crossing; the cells decided by k - s.
   // k at the first cell comes from a neighbouring row's cap-free run, across the crossings between the two cell
   // centres, or else from one evaluation of w + s there.
@@ -474,7 +476,7 @@ std::pair<uint64_t, uint64_t> decideRuns(const Grid& grid, const Scene& scene, s
     const Vec3 first = cellCentre(grid, rowBase + run.lo);
     const double width = cellBoundary(grid.bounds, grid.dims, 0, int64_t(run.lo) + 1) - box.lo.x;
     if (!caps->crossings(0, first, box.lo.x, box.hi.x, first.x, width, cuts)) return byWinding(r, run, counts);
-    int64_t k0 = neighbourK(r, run.lo, first, groupK, groups);
+    int64_t k0 = neighbourK(grid, t, *caps, state, groupK, groups, r, run.lo, first);
     if (k0 == kUnknown) {
       ++counts[0];
       const double v = w->rough(first) + windingNumber(caps->tree, first);
@@ -509,7 +511,7 @@ std::pair<uint64_t, uint64_t> decideRuns(const Grid& grid, const Scene& scene, s
   });
   if (!winding || !caps->enabled) return {sweep.full, sweep.caps};
   const UnionFind groups =
-      linkRuns(t, grid, [&](const Interval& run) { return state[run.slot] == kByInteger || state[run.slot] == kByCaps; });
+      linkRuns(t, grid, [&](const Interval& run) { return sharesK(state[run.slot]); });
   const std::vector<int64_t> k = groupIntegers(grid, t, *w, *caps, groups, state, sweep);
   // Pass 2: the waiting runs, by k alone, by k - s, or by w itself when k could not be told.
   sweep([&](size_t r, const Interval& run, uint64_t* counts) {
@@ -517,7 +519,7 @@ std::pair<uint64_t, uint64_t> decideRuns(const Grid& grid, const Scene& scene, s
       pieces[run.slot] = crossedRun(r, run, runBox(grid, t.row[r] * nx, run), k, groups, counts);
       return;
     }
-    if (state[run.slot] != kByInteger && state[run.slot] != kByCaps) return;
+    if (!sharesK(state[run.slot])) return;
     const int64_t kRun = k[groups.findConst(run.slot)];
     if (kRun == kUnknown) {
       pieces[run.slot] = byWinding(r, run, counts);

@@ -16,6 +16,16 @@ inline constexpr size_t kSetHeaderSize = 32;
 inline constexpr char kSetMagic[8] = {'V', 'O', 'X', 'G', 'S', 'E', 'T', '\n'};
 inline constexpr char kBrickMagic[8] = {'V', 'O', 'X', 'B', 'R', 'C', 'K', '\n'};
 
+// A grid without cells on the plan of `plan` (a Grid or a GridSetManifest: both carry bounds, dims and method).
+template <typename Plan>
+Grid emptyGridLike(const Plan& plan) {
+  Grid g;
+  g.bounds = plan.bounds;
+  g.dims = plan.dims;
+  g.method = plan.method;
+  return g;
+}
+
 // The header's checksum field of a file's bytes (0 when too short).
 inline uint64_t headerChecksum(const std::string& fileBytes) {
   uint64_t c = 0;

@@ -22,14 +22,6 @@ std::string besideManifest(const std::string& setPath, const std::string& file) 
   return (std::filesystem::path(setPath).parent_path() / file).string();
 }
 
-Grid emptyPlan(const GridSetManifest& set) {
-  Grid g;
-  g.bounds = set.bounds;
-  g.dims = set.dims;
-  g.method = set.method;
-  return g;
-}
-
 }  // namespace
 
 std::string brickFileName(const std::string& setPath, const std::array<uint32_t, 3>& index) {
@@ -52,10 +44,7 @@ void makeBrickFolder(const std::string& setPath) {
 }
 
 GridSetScene writeGridSetScene(const std::string& setPath, const Scene& scene, const Grid& plan, bool write) {
-  Grid g;
-  g.bounds = plan.bounds;
-  g.dims = plan.dims;
-  g.method = plan.method;
+  Grid g = emptyGridLike(plan);
   g.outsidePrims = plan.outsidePrims;
   const std::string bytes = encodeGridFile(scene, g);
   GridSetScene s{sceneFileName(setPath), bytes.size(), headerChecksum(bytes)};
@@ -100,7 +89,7 @@ BrickEntry writeBrick(const std::string& setPath, const GridSetManifest& set, co
 FillReport fillGridSet(const std::string& setPath, GridSetManifest& set, const Scene& scene,
                        const FillOptions& options) {
   // The occupied cells of the whole grid, keys only: all that fillSolid reads of a grid besides its plan.
-  Grid keys = emptyPlan(set);
+  Grid keys = emptyGridLike(set);
   uint64_t occupied = 0;
   for (const BrickEntry& e : set.entries) occupied += e.occupied;
   if (double(occupied) * 8 > double(options.memoryLimitBytes))
@@ -123,7 +112,7 @@ FillReport fillGridSet(const std::string& setPath, GridSetManifest& set, const S
   for (auto& [number, runs] : split) {
     while (e < set.entries.size() && brickNumber(set.bricks, set.entries[e].index) < number)
       entries.push_back(set.entries[e++]);
-    Grid cells = emptyPlan(set);
+    Grid cells = emptyGridLike(set);
     if (e < set.entries.size() && brickNumber(set.bricks, set.entries[e].index) == number)
       cells = readBrick(setPath, set, e++, scene.boundedCount());
     cells.solidRuns = std::move(runs);

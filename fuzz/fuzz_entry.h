@@ -3,17 +3,23 @@
 // sanitizer report or a hang is a finding.
 #pragma once
 
+#include <cctype>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "vox/trace/accel.h"
 #include "vox/core/error.h"
 #include "vox/io/grid_file.h"
+#include "vox/io/grid_set.h"
+#include "vox/io/info.h"
 #include "vox/import/import.h"
 #include "vox/trace/render.h"
 #include "vox/export/voxel_mesh.h"
@@ -70,17 +76,22 @@ inline void exerciseDecodedGrid(const GridFile& file) {
   }
 }
 
-// Decodes `bytes` as a grid file after rewriting the header's payload size (offset 16) and checksum (offset 24),
-// so that mutations reach the reader's own checks of counts, offsets and ids instead of stopping at the checksum
-// (docs/grid-format.md). What decodes is traced and exported (exerciseDecodedGrid).
-inline void decodeGridBytes(std::string bytes) {
+// Rewrites the header's payload size (offset 16) and checksum (offset 24) of a grid file, manifest or brick file (all
+// share the 32-byte header, docs/grid-format.md), so that mutations reach the readers' own checks of counts, offsets,
+// ids and names instead of stopping at the checksum.
+inline void fixHeader(std::string& bytes) {
   constexpr size_t kHeader = 32;
-  if (bytes.size() >= kHeader) {
-    const uint64_t size = bytes.size() - kHeader;
-    const uint64_t sum = gridChecksum(bytes.data() + kHeader, size);
-    std::memcpy(&bytes[16], &size, 8);
-    std::memcpy(&bytes[24], &sum, 8);
-  }
+  if (bytes.size() < kHeader) return;
+  const uint64_t size = bytes.size() - kHeader;
+  const uint64_t sum = gridChecksum(bytes.data() + kHeader, size);
+  std::memcpy(&bytes[16], &size, 8);
+  std::memcpy(&bytes[24], &sum, 8);
+}
+
+// Decodes `bytes` as a grid file (header fixed first, fixHeader). What decodes is traced and exported
+// (exerciseDecodedGrid).
+inline void decodeGridBytes(std::string bytes) {
+  fixHeader(bytes);
   GridFile file;
   try {
     file = decodeGridFile(bytes, "fuzz.vgrid");
@@ -88,6 +99,134 @@ inline void decodeGridBytes(std::string bytes) {
     return;
   }
   exerciseDecodedGrid(file);
+}
+
+// A grid set as one input: the manifest, the scene file and the brick files (in the manifest's order), joined by
+// this marker. scripts/fuzz.sh makes the seeds the same way.
+inline constexpr std::string_view kSetPartMarker = "\nVOXPART\n";
+
+inline std::vector<std::string> splitSetParts(std::string_view bytes) {
+  std::vector<std::string> parts;
+  for (size_t at = 0;;) {
+    const size_t next = bytes.find(kSetPartMarker, at);
+    parts.emplace_back(bytes.substr(at, next == std::string_view::npos ? std::string_view::npos : next - at));
+    if (next == std::string_view::npos || parts.size() == 64) return parts;
+    at = next + kSetPartMarker.size();
+  }
+}
+
+// Whether the harness may write a file the manifest names: relative, no "." or ".." part, few short parts. Names
+// that fail are still in the manifest; the reader must refuse them (or find no file) on its own.
+inline bool writableName(const std::string& name) {
+  const std::filesystem::path p(name);
+  if (name.empty() || name.size() > 96 || p.is_absolute() || p.has_root_name() || name.back() == '/') return false;
+  int depth = 0;
+  for (const auto& part : p) {
+    const std::string s = part.string();
+    if (s.empty() || s == "." || s == ".." || ++depth > 3) return false;
+    for (char c : s)
+      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-') return false;
+  }
+  return true;
+}
+
+// Writes `bytes` at `folder/name` (creating its folders) when the name is writable; a failure only means no file.
+inline void writePart(const std::filesystem::path& folder, const std::string& name, const std::string& bytes) {
+  if (!writableName(name)) return;
+  const std::filesystem::path path = folder / name;
+  std::error_code ignored;
+  std::filesystem::create_directories(path.parent_path(), ignored);
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+// Whether `name` (relative to `folder`) stays inside `folder` lexically; nothing the harness writes is a link.
+inline bool staysInside(const std::filesystem::path& folder, const std::string& name) {
+  const std::filesystem::path p(name);
+  if (p.is_absolute() || p.has_root_name()) return false;
+  const std::string base = folder.lexically_normal().string();
+  const std::string full = (folder / p).lexically_normal().string();
+  return full.size() > base.size() && full.compare(0, base.size(), base) == 0 && full[base.size()] == '/';
+}
+
+// An error from reading a set must be one line that names a file of the set (its manifest, scene or brick file):
+// the tools print it as it is (README "Limits and errors").
+inline void checkSetError(const Error& e, const std::string& folder) {
+  const std::string what = e.what();
+  if (what.find('\n') != std::string::npos || what.find(folder) == std::string::npos) {
+    std::fprintf(stderr, "set error without its file, or on more than one line: %s\n", what.c_str());
+    std::abort();
+  }
+}
+
+// Reads a grid set made of `bytes` (parts split by kSetPartMarker): headers fixed, then, when the manifest decodes,
+// its listed sizes and checksums set to the parts given (so the bricks' contents are reached), each part written
+// where the manifest names it inside the private folder, and the set read whole (readGridOrSet, as vox-trace and
+// vox-export do: then traced and meshed) and lazily (writeGridSetInfo, as vox-info does). Findings besides crashes:
+// a read that succeeds with a name leading out of the set's folder, an error that is not one line naming the set's
+// file, and the two readers disagreeing (one refuses what the other reads, or their vox-info output differs).
+inline void readGridSetBytes(std::string_view input) {
+  std::vector<std::string> parts = splitSetParts(input);
+  for (std::string& part : parts) fixHeader(part);
+  GridSetManifest m;
+  try {
+    m = decodeGridSetManifest(parts[0], "fuzz.vgrid");
+  } catch (const Error&) {
+    return;
+  }
+  const std::filesystem::path folder = std::filesystem::path(privateFolder()) / "set";
+  std::error_code ignored;
+  std::filesystem::remove_all(folder, ignored);
+  std::filesystem::create_directories(folder, ignored);
+  auto listPart = [&](size_t i, uint64_t& size, uint64_t& checksum) {
+    if (i >= parts.size()) return;
+    size = parts[i].size();
+    checksum = 0;
+    if (size >= 32) std::memcpy(&checksum, parts[i].data() + 24, 8);
+  };
+  listPart(1, m.scene.fileSize, m.scene.checksum);
+  for (size_t i = 0; i < m.entries.size(); ++i) listPart(2 + i, m.entries[i].fileSize, m.entries[i].fileChecksum);
+  if (parts.size() > 1) writePart(folder, m.scene.file, parts[1]);
+  for (size_t i = 0; i < m.entries.size() && 2 + i < parts.size(); ++i) writePart(folder, m.entries[i].file, parts[2 + i]);
+  const std::string path = (folder / "fuzz.vgrid").string();
+  writePart(folder, "fuzz.vgrid", encodeGridSetManifest(m));
+
+  InfoOptions options;
+  options.json = options.cells = true;
+  std::string whole, lazy;
+  bool wholeRead = false, lazyRead = false;
+  try {
+    const GridFile file = readGridOrSet(path);
+    wholeRead = true;
+    if (!staysInside(folder, m.scene.file)) std::abort();
+    for (const BrickEntry& e : m.entries)
+      if (!staysInside(folder, e.file)) std::abort();
+    whole = formatGridInfo(file, options);
+    exerciseDecodedGrid(file);
+  } catch (const Error& e) {
+    checkSetError(e, folder.string());
+  }
+  try {
+    std::ostringstream out;
+    writeGridSetInfo(out, path, options);
+    lazy = out.str();
+    lazyRead = true;
+  } catch (const Error& e) {
+    checkSetError(e, folder.string());
+  }
+  if (wholeRead != lazyRead || whole != lazy) {
+    std::fprintf(stderr, "readGridSet %s, the lazy reader %s, outputs %s\n", wholeRead ? "read" : "refused",
+                 lazyRead ? "read" : "refused", whole == lazy ? "equal" : "differ");
+    std::abort();
+  }
+}
+
+// The grid target's input: a grid set (parts starting with the manifest's magic) or a grid file.
+inline void readGridInput(std::string_view bytes) {
+  if (bytes.size() >= 8 && bytes.substr(0, 8) == std::string_view("VOXGSET\n", 8))
+    readGridSetBytes(bytes);
+  else
+    decodeGridBytes(std::string(bytes));
 }
 
 }  // namespace vox::fuzz

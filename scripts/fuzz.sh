@@ -127,6 +127,27 @@ made_grid "$m/all.txt" all --res 6
 made_grid "$root/tests/data/unit_cube.obj" cube --grid 3 2 1 --method sat
 made_grid "$root/scenes/scene5_02_spheres.txt" spheres --res 5 --method bbox
 made_grid "$m/all.txt" fill --res 4 --fill
+# Grid sets for the grid target, each as one input (fuzz/fuzz_entry.h, kSetPartMarker): the manifest, the scene file
+# and the brick files in the manifest's order (ascending z, y, x), joined by a marker line.
+made_set() {  # made_set SCENE NAME [voxelize options]; a seed less if the scene is refused
+  local scene=$1 name=$2; shift 2
+  mkdir -p "$m/sets"
+  "$build/vox-voxelize" "$scene" -o "$m/sets/$name.vgrid" --quiet "$@" || { echo "fuzz.sh: no seed $name set" >&2; return 0; }
+  python3 - "$m/sets/$name.vgrid" "$m/${name}_set.vgrid" <<'PY'
+import glob, re, sys
+manifest, out = sys.argv[1], sys.argv[2]
+folder = manifest[:-len('.vgrid')] + '.bricks'
+def order(path):
+    x, y, z = map(int, re.search(r'b_(\d+)_(\d+)_(\d+)\.vgrid$', path).groups())
+    return (z, y, x)
+bricks = sorted(glob.glob(folder + '/b_*.vgrid'), key=order)
+parts = [open(p, 'rb').read() for p in [manifest, folder + '/scene.vgrid'] + bricks]
+open(out, 'wb').write(b'\nVOXPART\n'.join(parts))
+PY
+}
+made_set "$m/all.txt" all --res 6 --bricks 2 2 1
+made_set "$root/tests/data/unit_cube.obj" cube --grid 3 2 1 --method sat --bricks 3 2 1
+made_set "$m/all.txt" fill --res 4 --fill --bricks 2 1 2
 for g in all cube spheres; do
   [ -f "$m/$g.vgrid" ] || continue
   for ext in ply obj gltf glb; do "$build/vox-export" "$m/$g.vgrid" -o "$m/${g}_voxels.$ext" --faces merged --quiet; done

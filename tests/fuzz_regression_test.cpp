@@ -12,7 +12,7 @@
 namespace vox {
 namespace {
 
-// Target name -> scene file extension (the grid target has its own entry point).
+// Target name -> scene file extension (the grid target, grid files and grid sets, has its own entry point).
 const std::map<std::string, std::string> kSceneTargets{
     {"course", "txt"}, {"obj", "obj"}, {"ply", "ply"}, {"gltf", "gltf"}, {"glb", "glb"}};
 
@@ -28,7 +28,7 @@ TEST(FuzzRegression, SavedInputsLoadOrAreRefused) {
       std::ifstream in(entry.path(), std::ios::binary);
       const std::string bytes{std::istreambuf_iterator<char>(in), {}};
       if (target == "grid")
-        EXPECT_NO_THROW(fuzz::decodeGridBytes(bytes));
+        EXPECT_NO_THROW(fuzz::readGridInput(bytes));
       else
         EXPECT_NO_THROW(fuzz::loadSceneBytes(bytes, kSceneTargets.at(target)));
       ++replayed;

@@ -95,8 +95,21 @@ TEST(GridSet, ManifestsThatLieAreRefused) {
   m.entries[0].file = "../" + m.entries[0].file;
   refused(m, "outside");
   m = good;
+  m.entries[0].file = m.entries[0].file + "/../../../" + m.entries[0].file;  // out through the brick folder
+  refused(m, "outside");
+  m = good;
+  m.scene.file = "../" + m.scene.file;
+  refused(m, "outside");
+  m = good;
   m.entries[0].file = "/etc/passwd";
   refused(m, "absolute");
+  // Counts a brick file of the listed size cannot hold: refused before the whole grid's arrays are sized by them.
+  m = good;
+  m.entries[0].occupied = m.entries[0].references = uint64_t(1) << 40;
+  refused(m, "larger than its file");
+  m = good;
+  m.entries[0].fileSize += 1;
+  refused(m, "not the brick");
   m = good;
   std::swap(m.entries[0].file, m.entries[1].file);  // each brick file under the other's index
   refused(m, "not the brick");

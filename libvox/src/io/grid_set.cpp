@@ -4,6 +4,7 @@
 #include "vox/io/grid_set.h"
 
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 
 #include "io/grid_set_header.h"
@@ -73,6 +74,11 @@ void checkEntries(ByteReader& r, const GridSetManifest& m, uint64_t occupied, ui
     if (e.occupied == 0 && e.solid == 0) r.corrupt(which + "empty brick listed");
     if (e.references < e.occupied || (e.occupied == 0) != (e.references == 0))
       r.corrupt(which + "references do not match the cells");
+    // A brick file stores 16 bytes per cell (key, offset) and 4 per reference after its 32-byte header: counts its
+    // listed size cannot hold are refused here, before a reader sizes anything by them.
+    if (e.fileSize < kSetHeaderSize || e.occupied > e.fileSize / 16 || e.references > e.fileSize / 4 ||
+        e.occupied * 16 + e.references * 4 > e.fileSize)
+      r.corrupt(which + "cell counts larger than its file");
     const uint64_t add[3] = {e.occupied, e.references, e.solid};
     for (int k = 0; k < 3; ++k) {
       sum[k] += add[k];
@@ -235,6 +241,15 @@ GridFile readGridSet(const std::string& path) {
   }
   checkMemory(double(occupied) * 16 + double(references) * 4 + double(occupied) * 4, path, "the assembled grid");
   if (occupied > UINT32_MAX) fail<LimitError>(path, ": ", occupied, " cells are more than one process assembles");
+  // The counts are the manifest's word until each brick is read: its files must be on disk at their listed sizes
+  // (which bound the counts, decodeGridSetManifest) before the whole grid's arrays are sized by them.
+  for (const BrickEntry& e : m.entries) {
+    const std::string brick = resolveInsideFolder(path, e.file);
+    requireRegularFile(brick, "brick file");
+    std::error_code ec;
+    if (std::filesystem::file_size(brick, ec) != e.fileSize || ec)
+      fail<InputError>(brick, ": not the brick ", path, " names (size differs; rewritten since?)");
+  }
   GridFile whole = readGridSetScene(path, m);
   Grid& g = whole.grid;
   g.cellKeys.reserve(occupied);

@@ -7,9 +7,12 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "test_util.h"
 #include "vox/core/error.h"
+#include "vox/export/binvox_writer.h"
+#include "vox/export/voxel_runs.h"
 #include "vox/io/atomic_file.h"
 #include "vox/io/info.h"
 #include "vox/io/input_file.h"
@@ -224,6 +227,43 @@ TEST(GridSet, StreamedInfoEqualsTheSingleGrids) {
       writeGridSetInfo(out, path, io);
       EXPECT_EQ(out.str(), formatGridInfo(file, io));
     }
+  }
+}
+
+// vox-export writes binvox from a set's layers of bricks, keys only (LayerCells::KeysOnly), instead of assembling
+// it: the file is the single grid's, byte for byte, with solid runs crossing bricks (fill) and bricks of one cell.
+TEST(GridSet, BinvoxFromLayersEqualsTheSingleGrids) {
+  testing::ScratchDir dir("gridset_binvox");
+  const Scene scene = testing::boxScene(0.1, 0.8);
+  VoxelizeOptions o;
+  o.dims = std::array<uint32_t, 3>{9, 8, 7};
+  o.bounds = Box{{0, 0, 0}, {1, 1, 1}};
+  Grid single = voxelizeScene(scene, o);
+  fillSolid(single, scene);
+  std::ostringstream want;
+  writeBinvox(want, single);
+  for (const auto bricks : {std::array<uint32_t, 3>{1, 1, 1}, {3, 2, 4}, {2, 8, 1}, {9, 8, 7}}) {
+    const std::string path = dir.file("b.vgrid");
+    std::filesystem::remove_all(dir.file("b.bricks"));
+    const FillOptions fo;
+    writeGridSet(path, scene, o, bricks, nullptr, &fo);
+    const GridSetManifest m = readGridSetManifest(path);
+    const GridFile sceneFile = readGridSetScene(path, m);
+    int layers = 0;
+    const VoxelRowSource rows = [&](const std::function<void(const VoxelRow&)>& visit) {
+      forEachGridSetLayer(
+          path, m, sceneFile,
+          [&](const Grid& layer) {
+            EXPECT_TRUE(layer.primIds.empty());  // no primitive list is kept
+            ++layers;
+            forEachVoxelRow(layer, visit);
+          },
+          LayerCells::KeysOnly);
+    };
+    std::ostringstream got;
+    writeBinvox(got, sceneFile.grid, rows);
+    EXPECT_EQ(got.str(), want.str()) << bricks[0] << "x" << bricks[1] << "x" << bricks[2] << " bricks";
+    EXPECT_EQ(layers, 2 * int(bricks[2]));  // two passes, a layer at a time
   }
 }
 

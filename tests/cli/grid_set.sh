@@ -82,6 +82,13 @@ for faces in all exposed merged; do
   check "export set $faces" 0 "$E" "$T/bbox_set.vgrid" -o "$T/b_$faces.ply" --faces $faces -q
   same "export $faces of set and grid" "$T/a_$faces.ply" "$T/b_$faces.ply"
 done
+# Voxel formats too; binvox is written from the set's layers of bricks, never assembled (vox-export). Not .vdb:
+# OpenVDB writes a new random UUID into every file's header.
+for ext in binvox vox; do
+  check "export $ext" 0 "$E" "$T/bbox.vgrid" -o "$T/a.$ext" -q
+  check "export set $ext" 0 "$E" "$T/bbox_set.vgrid" -o "$T/b.$ext" -q
+  same "export .$ext of set and grid" "$T/a.$ext" "$T/b.$ext"
+done
 
 # A scene of planes only: no occupied cell, no brick file; the set's scene file keeps the planes.
 printf 'OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 5 }\nLights { numLights 1 DirectionalLight { direction 0 0 -1 color 1 1 1 } }\nBackground { color 0 0 0 ambientLight 0.2 0.2 0.2 }\nMaterials { numMaterials 1 Material { diffuseColor 1 0 0 } }\nGroup { numObjects 1 MaterialIndex 0 Plane { normal 0 1 0 offset -1 } }\n' >"$T/planes.txt"
@@ -105,6 +112,9 @@ compare_fill() {  # compare_fill TAG SCENE "GRID ARGS" "BRICKS"
   check "$tag fill export" 0 "$E" "$T/$tag.vgrid" -o "$T/$tag.ply" --faces all --color none -q
   check "$tag fill set export" 0 "$E" "$T/${tag}_set.vgrid" -o "$T/${tag}_set.ply" --faces all --color none -q
   same "$tag: export of the filled set and grid" "$T/$tag.ply" "$T/${tag}_set.ply"
+  check "$tag fill binvox" 0 "$E" "$T/$tag.vgrid" -o "$T/$tag.binvox" -q
+  check "$tag fill set binvox" 0 "$E" "$T/${tag}_set.vgrid" -o "$T/${tag}_set.binvox" -q
+  same "$tag: binvox of the filled set and grid" "$T/$tag.binvox" "$T/${tag}_set.binvox"
 }
 compare_fill fill_bunny "$S/scene5_07_bunny_mesh_1k.txt" "--grid 15 15 12" "7 5 3"
 compare_fill fill_bunny1 "$S/scene5_07_bunny_mesh_1k.txt" "--grid 15 15 12" "1 1 1"

@@ -12,6 +12,7 @@
 #include "vox/core/progress.h"
 #include "vox/export/voxel_mesh.h"
 #include "vox/export/voxel_format.h"
+#include "vox/export/voxel_runs.h"
 
 namespace {
 
@@ -37,15 +38,35 @@ int runVoxelFormat(const Options& opt, vox::VoxelFormat format) {
   checkOutputPath(opt.output, {opt.grid});
   const ColorMode color = parseColorMode(opt.color);
   ProgressBar bar("exporting", opt.common.quiet);
-  const GridFile file = readGridOrSet(opt.grid);
+  // binvox needs only the voxel rows in key order: a set is then read one layer of bricks at a time, keys only (on
+  // each of the writer's two passes), instead of assembled, which keeps the peak memory to a layer (docs/scaling.md).
+  const bool layered = format == VoxelFormat::Binvox && isGridSet(opt.grid);
+  GridSetManifest set;
+  GridFile file;
+  if (layered) {
+    set = readGridSetManifest(opt.grid);
+    file = readGridSetScene(opt.grid, set);
+  } else {
+    file = readGridOrSet(opt.grid);
+  }
+  uint64_t occupied = file.grid.occupiedCount(), solid = file.grid.solidCount();
+  for (const BrickEntry& e : set.entries) {
+    occupied += e.occupied;
+    solid += e.solid;
+  }
   bar.update(0.1);
   std::vector<Rgb8> colors;
   if (format == VoxelFormat::MagicaVoxel && color != ColorMode::None)
     colors = occupiedCellColors(file.grid, file.scene, color);
   bar.update(0.2);
   const auto writeStart = std::chrono::steady_clock::now();
-  const VoxelFileReport report =
-      writeVoxelFile(opt.output, format, file.grid, colors, [&](double f) { bar.update(0.2 + 0.8 * f); });
+  const auto progress = [&](double f) { bar.update(0.2 + 0.8 * f); };
+  const VoxelRowSource setRows = [&](const std::function<void(const VoxelRow&)>& visit) {
+    forEachGridSetLayer(
+        opt.grid, set, file, [&](const Grid& layer) { forEachVoxelRow(layer, visit); }, LayerCells::KeysOnly);
+  };
+  const VoxelFileReport report = layered ? writeBinvoxFile(opt.output, file.grid, setRows, progress)
+                                         : writeVoxelFile(opt.output, format, file.grid, colors, progress);
   const double writeSeconds = secondsSince(writeStart);
   bar.finish();
   if (format == VoxelFormat::Binvox && report.binvoxShiftVoxels > 1e-9 && !opt.common.quiet)
@@ -62,8 +83,7 @@ int runVoxelFormat(const Options& opt, vox::VoxelFormat format) {
     std::fprintf(stderr,
                  "voxels: %llu\noccupied_cells: %zu\nsolid_cells: %llu\n%s: %llu\ncolors: %u\n"
                  "palette_colors: %u\noutput_bytes: %llu\nwrite_seconds: %.6f\ntotal_seconds: %.6f\n",
-                 (unsigned long long)report.voxels, file.grid.occupiedCount(),
-                 (unsigned long long)file.grid.solidCount(), format == VoxelFormat::Vdb ? "vdb_leaf_nodes" : "models",
+                 (unsigned long long)report.voxels, size_t(occupied), (unsigned long long)solid, format == VoxelFormat::Vdb ? "vdb_leaf_nodes" : "models",
                  (unsigned long long)report.models, report.gridColors,
                  report.paletteColors, (unsigned long long)(sizeError ? 0 : bytes), writeSeconds,
                  secondsSince(start));

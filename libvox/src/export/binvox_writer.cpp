@@ -103,24 +103,29 @@ BinvoxLayout binvoxLayout(const Grid& grid) {
 }
 
 BinvoxLayout writeBinvox(std::ostream& out, const Grid& grid, const std::function<void(double)>& progress) {
-  const BinvoxLayout layout = binvoxLayout(grid);
+  const VoxelRowSource rows = [&](const std::function<void(const VoxelRow&)>& visit) { forEachVoxelRow(grid, visit); };
+  return writeBinvox(out, grid, rows, progress);
+}
+
+BinvoxLayout writeBinvox(std::ostream& out, const Grid& plan, const VoxelRowSource& forEachRow,
+                         const std::function<void(double)>& progress) {
+  const BinvoxLayout layout = binvoxLayout(plan);
   const uint64_t d = layout.dim;
   const uint64_t planeBits = d * d;
-  // Toggle events bucketed by the plane x where they happen (x = D: past the last plane, dropped).
-  uint64_t rows = 0;
-  forEachVoxelRow(grid, [&](const VoxelRow&) { ++rows; });
-  checkMemory(double(rows) * 2 * sizeof(uint32_t) + double(d + 1) * sizeof(uint64_t) + double(planeBits) / 8,
-              "binvox", "run events and one plane");
+  // Toggle events bucketed by the plane x where they happen (x = D: past the last plane, dropped). Counted in one
+  // pass over the rows (the counts are D + 2 numbers), checked against the budget before the events are allocated.
   std::vector<uint64_t> eventStart(d + 2, 0);
-  forEachVoxelRow(grid, [&](const VoxelRow& r) {
+  forEachRow([&](const VoxelRow& r) {
     ++eventStart[r.i0 + 1];
     ++eventStart[r.i0 + r.count + 1];
   });
   for (size_t x = 1; x < eventStart.size(); ++x) eventStart[x] += eventStart[x - 1];
+  checkMemory(double(eventStart.back()) * sizeof(uint32_t) + double(d + 1) * sizeof(uint64_t) + double(planeBits) / 8,
+              "binvox", "run events and one plane");
   std::vector<uint32_t> events(eventStart.back());
   {
     std::vector<uint64_t> fill(eventStart.begin(), eventStart.end() - 1);
-    forEachVoxelRow(grid, [&](const VoxelRow& r) {
+    forEachRow([&](const VoxelRow& r) {
       const uint32_t bit = uint32_t(uint64_t(r.k) * d + r.j);  // D <= 4096, so D*D < 2^32
       events[fill[r.i0]++] = bit;
       events[fill[r.i0 + r.count]++] = bit;

@@ -54,4 +54,24 @@ VoxelFileReport writeVoxelFile(const std::string& path, VoxelFormat format, cons
   return report;
 }
 
+VoxelFileReport writeBinvoxFile(const std::string& path, const Grid& plan, const VoxelRowSource& rows,
+                                const std::function<void(double)>& progress) {
+  VoxelFileReport report;
+  OutputFile file(path);
+  // The voxels are counted on the writer's passes over the rows (each pass counts them all; the last count stands).
+  const VoxelRowSource counting = [&](const std::function<void(const VoxelRow&)>& visit) {
+    uint64_t voxels = 0;
+    rows([&](const VoxelRow& r) {
+      voxels += r.count;
+      visit(r);
+    });
+    report.voxels = voxels;
+  };
+  const BinvoxLayout layout = writeBinvox(file.stream(), plan, counting, progress);
+  report.binvoxShiftVoxels = layout.farFaceShiftVoxels;
+  report.binvoxVoxelSide = layout.voxelSide;
+  file.commit();
+  return report;
+}
+
 }  // namespace vox

@@ -209,25 +209,27 @@ void sortLayer(Grid& grid, bool cells = true) {
   grid.primIds = std::move(sorted.primIds);
 }
 
-Grid emptyLike(const Grid& plan) {
-  Grid g;
-  g.bounds = plan.bounds;
-  g.dims = plan.dims;
-  g.method = plan.method;
-  return g;
-}
-
 }  // namespace
 
 void forEachGridSetLayer(const std::string& setPath, const GridSetManifest& m, const GridFile& sceneFile,
-                         const std::function<void(const Grid& layer)>& visit, bool sortCells) {
+                         const std::function<void(const Grid& layer)>& visit, LayerCells cells) {
   size_t i = 0;
   for (uint32_t bz = 0; bz < m.bricks[2]; ++bz) {
-    Grid layer = emptyLike(sceneFile.grid);
-    for (; i < m.entries.size() && m.entries[i].index[2] == bz; ++i)
-      appendBrick(layer, readBrick(setPath, m, i, sceneFile.scene.boundedCount()));
+    Grid layer = emptyGridLike(sceneFile.grid);
+    for (; i < m.entries.size() && m.entries[i].index[2] == bz; ++i) {
+      Grid brick = readBrick(setPath, m, i, sceneFile.scene.boundedCount());
+      if (cells == LayerCells::KeysOnly) {
+        brick.cellStart = {0};
+        std::vector<uint32_t>().swap(brick.primIds);
+      }
+      appendBrick(layer, brick);
+    }
     if (layer.cellKeys.size() > UINT32_MAX) fail<LimitError>(setPath, ": a layer of bricks holds more than 2^32 cells");
-    sortLayer(layer, sortCells);
+    sortLayer(layer, cells == LayerCells::Sorted);
+    if (cells == LayerCells::KeysOnly) {
+      std::sort(layer.cellKeys.begin(), layer.cellKeys.end());
+      layer.cellStart.clear();
+    }
     visit(layer);
   }
 }

@@ -12,6 +12,7 @@
 
 #include "vox/core/grid.h"
 #include "vox/core/math.h"
+#include "vox/export/voxel_runs.h"
 
 namespace vox {
 
@@ -38,5 +39,10 @@ BinvoxLayout binvoxLayout(const Grid& grid);
 // layout.farFaceShiftVoxels matters. progress(fraction) is called now and then when given.
 // Throws LimitError as binvoxLayout, InputError for an inconsistent grid; write errors are the stream's.
 BinvoxLayout writeBinvox(std::ostream& out, const Grid& grid, const std::function<void(double)>& progress = {});
+// The same from the plan of a grid (bounds and dims; its cells are not read) and a source of its rows, asked twice
+// (to count the events per plane, then to place them; it must give the same rows both times). vox-export writes a
+// grid set this way, one layer of bricks in memory at a time instead of the whole grid.
+BinvoxLayout writeBinvox(std::ostream& out, const Grid& plan, const VoxelRowSource& rows,
+                         const std::function<void(double)>& progress = {});
 
 }  // namespace vox

@@ -10,6 +10,7 @@
 
 #include "vox/core/grid.h"
 #include "vox/export/voxel_mesh.h"
+#include "vox/export/voxel_runs.h"
 
 namespace vox {
 
@@ -34,5 +35,11 @@ struct VoxelFileReport {
 // Throws what the writers throw, and OutputError when the file cannot be written (the old file is then untouched).
 VoxelFileReport writeVoxelFile(const std::string& path, VoxelFormat format, const Grid& grid,
                                std::span<const Rgb8> cellColors, const std::function<void(double)>& progress = {});
+
+// binvox from the plan of a grid and a source of its voxel rows (writeBinvox's second form): what vox-export does for
+// a grid set, whose bricks are then read one layer at a time instead of assembled. The same file and report as
+// writeVoxelFile(Binvox) of the grid.
+VoxelFileReport writeBinvoxFile(const std::string& path, const Grid& plan, const VoxelRowSource& rows,
+                                const std::function<void(double)>& progress = {});
 
 }  // namespace vox

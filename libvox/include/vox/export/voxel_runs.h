@@ -24,6 +24,11 @@ struct VoxelRow {
 // checkSolidRuns.
 void forEachVoxelRow(const Grid& grid, const std::function<void(const VoxelRow&)>& visit);
 
+// A source of voxel rows: each call hands every row to `visit` in increasing key order, as forEachVoxelRow does
+// (a grid in memory, or a grid set read one layer of bricks at a time, which gives the same rows: a layer holds
+// whole z planes, and rows never leave their plane). Writers that need several passes call it several times.
+using VoxelRowSource = std::function<void(const std::function<void(const VoxelRow&)>& visit)>;
+
 // Number of distinct voxels (occupied or solid), counted from the runs. Same checks as forEachVoxelRow.
 uint64_t countVoxels(const Grid& grid);
 

@@ -118,12 +118,16 @@ Grid decodeBrickFile(const std::string& bytes, const std::string& name, const Gr
 // whole-grid keys (bounds, dims, method of the whole grid; no outsidePrims).
 Grid readBrick(const std::string& setPath, const GridSetManifest& manifest, size_t entry, uint64_t boundedCount);
 
+// What forEachGridSetLayer hands over of a layer's cells: sorted by key with their primitive lists (vox-info
+// --cells), in brick order with their lists (totals, which need no order), or sorted keys alone, cellStart and
+// primIds left empty (voxel rows, for binvox: no primitive list is kept or moved).
+enum class LayerCells : uint8_t { Sorted, BrickOrder, KeysOnly };
+
 // Streams a set in cell-key order, one layer of bricks at a time (all bricks with one bz: cells are ordered x
-// fastest, so the cells of a layer's bricks interleave): `visit` gets each layer's cells and solid runs, sorted,
-// runs merged within the layer. Peak memory is one layer, not the grid. With `sortCells` false the cells come in
-// brick order (for totals, which need no order; the runs are still sorted). Throws as readBrick.
+// fastest, so the cells of a layer's bricks interleave): `visit` gets each layer's cells as `cells` says and its
+// solid runs sorted, merged within the layer. Peak memory is one layer, not the grid. Throws as readBrick.
 void forEachGridSetLayer(const std::string& setPath, const GridSetManifest& manifest, const GridFile& sceneFile,
-                         const std::function<void(const Grid& layer)>& visit, bool sortCells = true);
+                         const std::function<void(const Grid& layer)>& visit, LayerCells cells = LayerCells::Sorted);
 
 // The whole grid of a set in memory: the bricks' cells merged. Equal to the grid the single-process voxelizer
 // makes. Throws InputError for a corrupt set, LimitError when it cannot fit the memory budget.

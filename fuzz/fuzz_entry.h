@@ -10,6 +10,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -20,6 +22,7 @@
 #include "vox/io/grid_file.h"
 #include "vox/io/grid_set.h"
 #include "vox/io/info.h"
+#include "vox/io/input_file.h"
 #include "vox/import/import.h"
 #include "vox/trace/render.h"
 #include "vox/export/voxel_mesh.h"
@@ -115,25 +118,25 @@ inline std::vector<std::string> splitSetParts(std::string_view bytes) {
   }
 }
 
-// Whether the harness may write a file the manifest names: relative, no "." or ".." part, few short parts. Names
-// that fail are still in the manifest; the reader must refuse them (or find no file) on its own.
-inline bool writableName(const std::string& name) {
-  const std::filesystem::path p(name);
-  if (name.empty() || name.size() > 96 || p.is_absolute() || p.has_root_name() || name.back() == '/') return false;
-  int depth = 0;
-  for (const auto& part : p) {
-    const std::string s = part.string();
-    if (s.empty() || s == "." || s == ".." || ++depth > 3) return false;
-    for (char c : s)
-      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-') return false;
-  }
-  return true;
+// Where the harness writes a part the manifest names `name`, or nothing: relative, short, plain characters, and
+// inside `area` (the set's folder or the folder above it, so that a name leading out of the set's folder finds a
+// file there, which the reader must still refuse). Other names stay in the manifest for the reader to refuse.
+inline std::optional<std::filesystem::path> partPath(const std::filesystem::path& area,
+                                                     const std::filesystem::path& folder, const std::string& name) {
+  if (name.empty() || name.size() > 96 || name.front() == '/' || name.back() == '/') return std::nullopt;
+  for (char c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-' && c != '/')
+      return std::nullopt;
+  const std::string base = area.lexically_normal().string() + "/";
+  const std::filesystem::path full = (folder / name).lexically_normal();
+  if (full.string().compare(0, base.size(), base) != 0 || std::distance(full.begin(), full.end()) >
+                                                              std::distance(area.begin(), area.end()) + 4)
+    return std::nullopt;
+  return full;
 }
 
-// Writes `bytes` at `folder/name` (creating its folders) when the name is writable; a failure only means no file.
-inline void writePart(const std::filesystem::path& folder, const std::string& name, const std::string& bytes) {
-  if (!writableName(name)) return;
-  const std::filesystem::path path = folder / name;
+// Writes `bytes` at `path` (creating its folders); a failure only means no file.
+inline void writePart(const std::filesystem::path& path, const std::string& bytes) {
   std::error_code ignored;
   std::filesystem::create_directories(path.parent_path(), ignored);
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
@@ -174,9 +177,10 @@ inline void readGridSetBytes(std::string_view input) {
   } catch (const Error&) {
     return;
   }
-  const std::filesystem::path folder = std::filesystem::path(privateFolder()) / "set";
+  // The set's folder is set/m: names with ".." may land in set/, which is emptied with it before every input.
+  const std::filesystem::path area = std::filesystem::path(privateFolder()) / "set", folder = area / "m";
   std::error_code ignored;
-  std::filesystem::remove_all(folder, ignored);
+  std::filesystem::remove_all(area, ignored);
   std::filesystem::create_directories(folder, ignored);
   auto listPart = [&](size_t i, uint64_t& size, uint64_t& checksum) {
     if (i >= parts.size()) return;
@@ -184,12 +188,16 @@ inline void readGridSetBytes(std::string_view input) {
     checksum = 0;
     if (size >= 32) std::memcpy(&checksum, parts[i].data() + 24, 8);
   };
+  auto placePart = [&](size_t i, const std::string& name) {
+    if (i >= parts.size()) return;
+    if (const auto path = partPath(area, folder, name)) writePart(*path, parts[i]);
+  };
   listPart(1, m.scene.fileSize, m.scene.checksum);
   for (size_t i = 0; i < m.entries.size(); ++i) listPart(2 + i, m.entries[i].fileSize, m.entries[i].fileChecksum);
-  if (parts.size() > 1) writePart(folder, m.scene.file, parts[1]);
-  for (size_t i = 0; i < m.entries.size() && 2 + i < parts.size(); ++i) writePart(folder, m.entries[i].file, parts[2 + i]);
+  placePart(1, m.scene.file);
+  for (size_t i = 0; i < m.entries.size(); ++i) placePart(2 + i, m.entries[i].file);
   const std::string path = (folder / "fuzz.vgrid").string();
-  writePart(folder, "fuzz.vgrid", encodeGridSetManifest(m));
+  writePart(path, encodeGridSetManifest(m));
 
   InfoOptions options;
   options.json = options.cells = true;
@@ -198,9 +206,13 @@ inline void readGridSetBytes(std::string_view input) {
   try {
     const GridFile file = readGridOrSet(path);
     wholeRead = true;
-    if (!staysInside(folder, m.scene.file)) std::abort();
-    for (const BrickEntry& e : m.entries)
-      if (!staysInside(folder, e.file)) std::abort();
+    std::vector<std::string> names{m.scene.file};
+    for (const BrickEntry& e : m.entries) names.push_back(e.file);
+    for (const std::string& name : names)
+      if (!staysInside(folder, name)) {
+        std::fprintf(stderr, "a set was read through %s, outside its folder\n", quoteInput(name).c_str());
+        std::abort();
+      }
     whole = formatGridInfo(file, options);
     exerciseDecodedGrid(file);
   } catch (const Error& e) {

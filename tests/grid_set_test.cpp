@@ -106,6 +106,13 @@ TEST(GridSet, ManifestsThatLieAreRefused) {
   m = good;
   m.entries[0].file = "/etc/passwd";
   refused(m, "absolute");
+  // A control byte in a name would split the one-line error that prints it (found by fuzz/fuzz_grid.cpp).
+  m = good;
+  m.entries[0].file = m.entries[0].file + "\nvox-info: ok";
+  refused(m, "bad file name");
+  m = good;
+  m.scene.file = "s\x7f";
+  refused(m, "bad scene file name");
   // Counts a brick file of the listed size cannot hold: refused before the whole grid's arrays are sized by them.
   m = good;
   m.entries[0].occupied = m.entries[0].references = uint64_t(1) << 40;

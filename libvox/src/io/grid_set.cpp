@@ -58,7 +58,12 @@ void getPlan(ByteReader& r, GridSetManifest& m) {
   }
 }
 
-bool badName(const std::string& file) { return file.empty() || file.find('\0') != std::string::npos; }
+// Names are printed in error lines: a control byte (a newline, say) would split the one-line error; our writer
+// never makes one (fuzz/fuzz_grid.cpp found a brick named with a newline).
+bool badName(const std::string& file) {
+  return file.empty() ||
+         std::any_of(file.begin(), file.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; });
+}
 
 // Entries in strictly ascending brick order, named, none empty, counts adding up to the totals.
 void checkEntries(ByteReader& r, const GridSetManifest& m, uint64_t occupied, uint64_t references, uint64_t solid) {

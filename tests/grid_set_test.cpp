@@ -147,6 +147,15 @@ TEST(GridSet, ManifestsThatLieAreRefused) {
   refused(m, "holds another brick");
 }
 
+// Readers refuse names with control bytes, so the writer refuses to make them.
+TEST(GridSet, NamesWithControlBytesAreNotWritten) {
+  testing::ScratchDir dir("gridset_names");
+  VoxelizeOptions o;
+  o.dims = std::array<uint32_t, 3>{6, 5, 4};
+  EXPECT_THROW(writeGridSet(dir.file("a\nb.vgrid"), sceneWithPlane(5), o, {2, 1, 1}), OutputError);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("a\nb.bricks")));
+}
+
 TEST(GridSet, NoManifestWhenABrickCannotBeWritten) {
   testing::ScratchDir dir("gridset_fail");
   const std::string path = dir.file("s.vgrid");

@@ -83,7 +83,8 @@ int runVoxelFormat(const Options& opt, vox::VoxelFormat format) {
     std::fprintf(stderr,
                  "voxels: %llu\noccupied_cells: %zu\nsolid_cells: %llu\n%s: %llu\ncolors: %u\n"
                  "palette_colors: %u\noutput_bytes: %llu\nwrite_seconds: %.6f\ntotal_seconds: %.6f\n",
-                 (unsigned long long)report.voxels, size_t(occupied), (unsigned long long)solid, format == VoxelFormat::Vdb ? "vdb_leaf_nodes" : "models",
+                 (unsigned long long)report.voxels, size_t(occupied), (unsigned long long)solid,
+                 format == VoxelFormat::Vdb ? "vdb_leaf_nodes" : "models",
                  (unsigned long long)report.models, report.gridColors,
                  report.paletteColors, (unsigned long long)(sizeError ? 0 : bytes), writeSeconds,
                  secondsSince(start));

@@ -1,5 +1,5 @@
 // Ray throughput of the grid against Embree 3 on the same triangles, rays and thread count.
-//   bench_trace [--threads N] [--size N] [--reps N] [--factor F ...] [--incoherent] [SCENE ...]
+//   bench_trace [--threads N] [--size N] [--reps N] [--factor F ...] [--incoherent [--ours-only]] [SCENE ...]
 // Default scenes: the 40k seed bunny, the 69k Stanford bunny (PLY), the 115k SheenCloth.
 // Primary rays (default): for each scene it voxelizes (exact) at each cells-per-triangle factor and traces size x size
 // primary rays from defaultCamera(bounds) with rtcIntersect1, rtcIntersect8 (coherent context, 4x2 pixel packets),
@@ -406,7 +406,8 @@ uint64_t bruteForceDifferences(const vox::Accel& brute, const RaySet& set, const
 }
 
 // Secondary rays of one scene on its default grid: Embree against ours, same rays, results checked.
-void benchIncoherent(const std::string& path, unsigned threads, uint32_t size, int reps) {
+// `oursOnly` (--ours-only): times only our walk and checks nothing, for profiling where our time goes.
+void benchIncoherent(const std::string& path, unsigned threads, uint32_t size, int reps, bool oursOnly) {
   const vox::Scene scene = vox::loadScene(path);
   const vox::Box bounds = *vox::sceneBounds(scene);
   const vox::Camera cam = vox::defaultCamera(bounds);
@@ -431,6 +432,15 @@ void benchIncoherent(const std::string& path, unsigned threads, uint32_t size, i
   std::printf("  %-11s %10s %10s %12s %12s %8s %8s %9s %9s %9s %s\n", "set", "query", "embree", "ours", "ours/embree",
               "(best)", "(cpu)", "same", "close t", "mismatch", "brute force (diff/checked), per ray");
   for (const RaySet& set : sets) {
+    if (oursOnly) {
+      std::vector<vox::Hit> ours(set.rays.size());
+      std::vector<Method> methods;
+      methods.push_back({"ours", [&] { voxTrace(accel, set, ours); }});
+      timeInTurns(methods, reps);
+      std::printf("  %-11s ours %.3f Mrays/s (median), cpu %.3f\n", set.name.c_str(),
+                  set.rays.size() / methods[0].median() / 1e6, set.rays.size() / methods[0].median(true) / 1e6);
+      continue;
+    }
     std::vector<EmbreeResult> e(set.rays.size());
     std::vector<vox::Hit> ours(set.rays.size());
     std::vector<Method> methods;
@@ -472,7 +482,7 @@ int main(int argc, char** argv) {
   int reps = 7;
   std::vector<double> factors;
   std::vector<std::string> scenes;
-  bool incoherent = false;
+  bool incoherent = false, oursOnly = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--threads" && i + 1 < argc) threads = unsigned(std::atoi(argv[++i]));
@@ -480,6 +490,7 @@ int main(int argc, char** argv) {
     else if (a == "--reps" && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
     else if (a == "--factor" && i + 1 < argc) factors.push_back(std::atof(argv[++i]));
     else if (a == "--incoherent") incoherent = true;
+    else if (a == "--ours-only") oursOnly = true;
     else scenes.push_back(a);
   }
   if (factors.empty()) factors = {0.5, 1, 2, 3};
@@ -496,7 +507,7 @@ int main(int argc, char** argv) {
     std::printf("threads: %u, image: %ux%u primary rays, best of %d rounds taken in turns\n", threads, size, size, reps);
 
   for (const std::string& path : scenes) {
-    if (incoherent) benchIncoherent(path, threads, size, reps);
+    if (incoherent) benchIncoherent(path, threads, size, reps, oursOnly);
     else benchPrimary(path, threads, size, reps, factors);
   }
   return 0;

@@ -613,6 +613,25 @@ TEST(WalkRobustness, ExactCoverageThroughRoundedCorners) {
   sparse.boundaries = makeCellBoundaries(g.bounds, g.dims);
   rays = 0;
   for (const Ray& ray : list) expectExactCoverage(g, ray, "sparse ray " + std::to_string(rays++), &sparse);
+
+  // Jumps over whole empty boxes of 2, 4 and 8 blocks a side (Accel::emptyShift): the same coverage, on this pattern
+  // and on a sparser one where most of those boxes are empty. It fails when a box holding a non-empty block is
+  // jumped over, or when a jump lands past the box's boundary.
+  for (int sparsity : {5, 40}) {
+    for (uint32_t& slot : sparse.blockSlot) slot = rng() % sparsity == 0 ? 0 : kEmptyCell;
+    buildEmptyShift(sparse);
+    int levels[4] = {0, 0, 0, 0};
+    for (uint8_t s : sparse.emptyShift) {
+      if (s != 0) ++levels[s - sparse.blockShift];
+    }
+    EXPECT_GT(levels[1], 0) << sparsity;
+    if (sparsity == 40) {
+      EXPECT_GT(levels[2], 0);
+    }
+    rays = 0;
+    for (const Ray& ray : list)
+      expectExactCoverage(g, ray, "boxes 1/" + std::to_string(sparsity) + " ray " + std::to_string(rays++), &sparse);
+  }
 }
 
 TEST(GridVsBruteForce, NearCoincidentHitsOnBothSidesOfABoundary) {

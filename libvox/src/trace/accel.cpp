@@ -101,6 +101,34 @@ void buildTables(Accel& accel, const Grid& grid) {
 
 }  // namespace
 
+void buildEmptyShift(Accel& accel) {
+  accel.emptyShift.clear();
+  if (accel.blockShift == 0) return;
+  const auto& bd = accel.blockDims;
+  accel.emptyShift.assign(accel.blockSlot.size(), 0);
+  for (size_t b = 0; b < accel.blockSlot.size(); ++b)
+    if (accel.blockSlot[b] == kEmptyCell) accel.emptyShift[b] = uint8_t(accel.blockShift);
+  // Level L: boxes of 2^L blocks a side; empty[L] from the 2x2x2 boxes of level L - 1 (those past the grid empty).
+  std::array<uint32_t, 3> d = bd;
+  std::vector<uint8_t> empty(accel.blockSlot.size());
+  for (size_t b = 0; b < empty.size(); ++b) empty[b] = accel.blockSlot[b] == kEmptyCell;
+  for (uint32_t level = 1; level <= kMaxSkipLevels; ++level) {
+    const std::array<uint32_t, 3> h{(d[0] + 1) / 2, (d[1] + 1) / 2, (d[2] + 1) / 2};
+    std::vector<uint8_t> up(size_t(h[0]) * h[1] * h[2], 1);
+    for (uint32_t z = 0; z < d[2]; ++z)
+      for (uint32_t y = 0; y < d[1]; ++y)
+        for (uint32_t x = 0; x < d[0]; ++x)
+          if (!empty[x + d[0] * (y + uint64_t(d[1]) * z)]) up[x / 2 + h[0] * (y / 2 + uint64_t(h[1]) * (z / 2))] = 0;
+    for (uint32_t z = 0; z < bd[2]; ++z)
+      for (uint32_t y = 0; y < bd[1]; ++y)
+        for (uint32_t x = 0; x < bd[0]; ++x)
+          if (up[(x >> level) + h[0] * ((y >> level) + uint64_t(h[1]) * (z >> level))])
+            accel.emptyShift[x + bd[0] * (y + uint64_t(bd[1]) * z)] = uint8_t(accel.blockShift + level);
+    empty = std::move(up);
+    d = h;
+  }
+}
+
 Accel buildAccel(const Scene& scene, const Grid& grid, AccelKind kind) {
   Accel accel;
   accel.kind = kind;
@@ -132,6 +160,7 @@ Accel buildAccel(const Scene& scene, const Grid& grid, AccelKind kind) {
   if (grid.occupiedCount() >= kSolidCell)
     fail<LimitError>("grid has ", grid.occupiedCount(), " occupied cells; at most 2^32 - 2 can be traced");
   buildTables(accel, grid);
+  buildEmptyShift(accel);
   accel.boundaries = makeCellBoundaries(grid.bounds, grid.dims);
   if (kind == AccelKind::Grid && grid.primIds.size() <= kMaxCellTriangleBytes / sizeof(TriangleData)) {
     accel.cellTriangles.resize(grid.primIds.size());

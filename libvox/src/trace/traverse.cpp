@@ -160,8 +160,12 @@ void GridWalker::queueExtras(int m, double tm, const WalkCell& from, bool n1, bo
 // cells of the block, and none of their extra cells can lie outside it (the ray is farther than the tolerance from
 // the other far faces, and the steps near the exit face come after T). The walker is then in the state the ordinary
 // walk reaches at T and goes on from there; every index increment counts as a step, so the bound on steps holds.
-void GridWalker::fastForward() {
-  const int64_t mask = blockMask();
+//
+// `shift` is the block's, or larger when the aligned box of 2^shift cells holding the block is empty as a whole
+// (Accel::emptyShift): the argument only needs an aligned box of cells without any primitive, and such a box's faces
+// are block faces, so the steps after the jump still look at each new block as they enter it.
+void GridWalker::fastForward(uint32_t shift) {
+  const int64_t mask = (int64_t(1) << shift) - 1;
   double tB[3];
   int64_t far[3];
   for (int a = 0; a < 3; ++a) {

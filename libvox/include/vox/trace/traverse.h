@@ -89,6 +89,7 @@ class GridWalker {
       shift_ = accel.blockShift;
       blockDims_[0] = accel.blockDims[0];
       blockDims_[1] = accel.blockDims[1];
+      emptyShift_ = accel.emptyShift.empty() ? nullptr : accel.emptyShift.data();
       checkBlock_ = true;
     }
   }
@@ -108,7 +109,12 @@ class GridWalker {
     if (done_) return false;
     if (checkBlock_) [[unlikely]] {
       checkBlock_ = false;
-      if (blockEmpty()) fastForward();
+      if (emptyShift_ != nullptr) {
+        const uint32_t skip = emptyShift_[blockIndex()];
+        if (skip != 0) fastForward(skip);
+      } else if (blockEmpty()) {
+        fastForward(shift_);
+      }
     }
     out.idx = {uint32_t(idx_[0]), uint32_t(idx_[1]), uint32_t(idx_[2])};
     out.tEnter = tCur_;
@@ -174,11 +180,12 @@ class GridWalker {
   }
   void queueExtras(int m, double tm, const WalkCell& from, bool n1, bool n2);
   int64_t blockMask() const { return (int64_t(1) << shift_) - 1; }
-  bool blockEmpty() const {
+  uint64_t blockIndex() const {
     const uint64_t bx = uint64_t(idx_[0]) >> shift_, by = uint64_t(idx_[1]) >> shift_, bz = uint64_t(idx_[2]) >> shift_;
-    return blockSlot_[bx + blockDims_[0] * (by + blockDims_[1] * bz)] == kEmptyCell;
+    return bx + blockDims_[0] * (by + blockDims_[1] * bz);
   }
-  void fastForward();
+  bool blockEmpty() const { return blockSlot_[blockIndex()] == kEmptyCell; }
+  void fastForward(uint32_t shift);
 
   std::unique_ptr<CellBoundaries> owned_;  // the tables, when the walker built them itself
   const double* bnd_[3] = {nullptr, nullptr, nullptr};
@@ -198,6 +205,7 @@ class GridWalker {
   const uint32_t* blockSlot_ = nullptr;
   uint32_t shift_ = 0;
   uint64_t blockDims_[2] = {0, 0};
+  const uint8_t* emptyShift_ = nullptr;  // Accel::emptyShift, when built
   bool checkBlock_ = false;
 };
 

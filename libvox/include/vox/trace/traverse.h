@@ -80,8 +80,9 @@ class GridWalker {
   // Accel::boundaries). A ray that misses the grid, or has a zero or non-finite direction, yields no cell.
   GridWalker(const CellBoundaries& cells, const Ray& ray) { init(cells, ray); }
   // The walk of traceRay and friends: through accel.boundaries, and skipping the cells of empty blocks of the
-  // two-level table (Accel::blockSlot) in one jump each (see fastForward); cells in empty blocks may therefore not
-  // be reported. `accel` must outlive the walker.
+  // two-level table (Accel::blockSlot) in one jump each, or of the largest empty aligned box of blocks holding one
+  // (Accel::emptyShift; see fastForward); cells in empty blocks may therefore not be reported. `accel` must outlive
+  // the walker.
   GridWalker(const Accel& accel, const Ray& ray) {
     init(accel.boundaries, ray);
     if (accel.blockShift != 0 && !done_) {

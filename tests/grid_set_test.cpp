@@ -223,15 +223,28 @@ TEST(GridSet, FillEqualsTheSingleGridsFill) {
   }
 }
 
+// A closed box in a 9x8x7 grid over the unit cube, filled, so that solid runs cross brick faces.
+struct FilledBox {
+  Scene scene = testing::boxScene(0.1, 0.8);
+  VoxelizeOptions options;
+  Grid grid;
+};
+FilledBox filledBox() {
+  FilledBox b;
+  b.options.dims = std::array<uint32_t, 3>{9, 8, 7};
+  b.options.bounds = Box{{0, 0, 0}, {1, 1, 1}};
+  b.grid = voxelizeScene(b.scene, b.options);
+  fillSolid(b.grid, b.scene);
+  return b;
+}
+
 // vox-info streams a set one layer of bricks at a time; its report is the single grid's, byte for byte.
 TEST(GridSet, StreamedInfoEqualsTheSingleGrids) {
   testing::ScratchDir dir("gridset_info");
-  const Scene scene = testing::boxScene(0.1, 0.8);
-  VoxelizeOptions o;
-  o.dims = std::array<uint32_t, 3>{9, 8, 7};
-  o.bounds = Box{{0, 0, 0}, {1, 1, 1}};
-  Grid single = voxelizeScene(scene, o);
-  fillSolid(single, scene);
+  const FilledBox box = filledBox();
+  const Scene& scene = box.scene;
+  const VoxelizeOptions& o = box.options;
+  const Grid& single = box.grid;
   const GridFile file{scene, single};
   for (const auto bricks : {std::array<uint32_t, 3>{1, 1, 1}, {3, 2, 4}, {9, 8, 7}}) {
     const std::string path = dir.file("i.vgrid");
@@ -250,12 +263,10 @@ TEST(GridSet, StreamedInfoEqualsTheSingleGrids) {
 // it: the file is the single grid's, byte for byte, with solid runs crossing bricks (fill) and bricks of one cell.
 TEST(GridSet, BinvoxFromLayersEqualsTheSingleGrids) {
   testing::ScratchDir dir("gridset_binvox");
-  const Scene scene = testing::boxScene(0.1, 0.8);
-  VoxelizeOptions o;
-  o.dims = std::array<uint32_t, 3>{9, 8, 7};
-  o.bounds = Box{{0, 0, 0}, {1, 1, 1}};
-  Grid single = voxelizeScene(scene, o);
-  fillSolid(single, scene);
+  const FilledBox box = filledBox();
+  const Scene& scene = box.scene;
+  const VoxelizeOptions& o = box.options;
+  const Grid& single = box.grid;
   std::ostringstream want;
   writeBinvox(want, single);
   for (const auto bricks : {std::array<uint32_t, 3>{1, 1, 1}, {3, 2, 4}, {2, 8, 1}, {9, 8, 7}}) {

@@ -238,19 +238,23 @@ FilledBox filledBox() {
   return b;
 }
 
+// The box written as a filled set NAME.vgrid in `bricks` (over any earlier one); returns the manifest's path.
+std::string writeFilledBoxSet(const testing::ScratchDir& dir, const std::string& name, const FilledBox& box,
+                              const std::array<uint32_t, 3>& bricks) {
+  const std::string path = dir.file(name + ".vgrid");
+  std::filesystem::remove_all(dir.file(name + ".bricks"));
+  const FillOptions fo;
+  writeGridSet(path, box.scene, box.options, bricks, nullptr, &fo);
+  return path;
+}
+
 // vox-info streams a set one layer of bricks at a time; its report is the single grid's, byte for byte.
 TEST(GridSet, StreamedInfoEqualsTheSingleGrids) {
   testing::ScratchDir dir("gridset_info");
   const FilledBox box = filledBox();
-  const Scene& scene = box.scene;
-  const VoxelizeOptions& o = box.options;
-  const Grid& single = box.grid;
-  const GridFile file{scene, single};
+  const GridFile file{box.scene, box.grid};
   for (const auto bricks : {std::array<uint32_t, 3>{1, 1, 1}, {3, 2, 4}, {9, 8, 7}}) {
-    const std::string path = dir.file("i.vgrid");
-    std::filesystem::remove_all(dir.file("i.bricks"));
-    const FillOptions fo;
-    writeGridSet(path, scene, o, bricks, nullptr, &fo);
+    const std::string path = writeFilledBoxSet(dir, "i", box, bricks);
     for (const InfoOptions io : {InfoOptions{false, false, false}, InfoOptions{true, true, true}}) {
       std::ostringstream out;
       writeGridSetInfo(out, path, io);
@@ -264,16 +268,10 @@ TEST(GridSet, StreamedInfoEqualsTheSingleGrids) {
 TEST(GridSet, BinvoxFromLayersEqualsTheSingleGrids) {
   testing::ScratchDir dir("gridset_binvox");
   const FilledBox box = filledBox();
-  const Scene& scene = box.scene;
-  const VoxelizeOptions& o = box.options;
-  const Grid& single = box.grid;
   std::ostringstream want;
-  writeBinvox(want, single);
+  writeBinvox(want, box.grid);
   for (const auto bricks : {std::array<uint32_t, 3>{1, 1, 1}, {3, 2, 4}, {2, 8, 1}, {9, 8, 7}}) {
-    const std::string path = dir.file("b.vgrid");
-    std::filesystem::remove_all(dir.file("b.bricks"));
-    const FillOptions fo;
-    writeGridSet(path, scene, o, bricks, nullptr, &fo);
+    const std::string path = writeFilledBoxSet(dir, "b", box, bricks);
     const GridSetManifest m = readGridSetManifest(path);
     const GridFile sceneFile = readGridSetScene(path, m);
     int layers = 0;

@@ -103,8 +103,7 @@ BinvoxLayout binvoxLayout(const Grid& grid) {
 }
 
 BinvoxLayout writeBinvox(std::ostream& out, const Grid& grid, const std::function<void(double)>& progress) {
-  const VoxelRowSource rows = [&](const std::function<void(const VoxelRow&)>& visit) { forEachVoxelRow(grid, visit); };
-  return writeBinvox(out, grid, rows, progress);
+  return writeBinvox(out, grid, voxelRows(grid), progress);
 }
 
 BinvoxLayout writeBinvox(std::ostream& out, const Grid& plan, const VoxelRowSource& forEachRow,

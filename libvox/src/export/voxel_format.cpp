@@ -13,6 +13,27 @@
 
 namespace vox {
 
+namespace {
+
+// binvox from a row source into `out`; the voxels are counted on the writer's passes over the rows (each pass counts
+// them all; the last count stands), so no pass of its own.
+void writeBinvoxRows(std::ostream& out, const Grid& plan, const VoxelRowSource& rows,
+                     const std::function<void(double)>& progress, VoxelFileReport& report) {
+  const VoxelRowSource counting = [&](const std::function<void(const VoxelRow&)>& visit) {
+    uint64_t voxels = 0;
+    rows([&](const VoxelRow& r) {
+      voxels += r.count;
+      visit(r);
+    });
+    report.voxels = voxels;
+  };
+  const BinvoxLayout layout = writeBinvox(out, plan, counting, progress);
+  report.binvoxShiftVoxels = layout.farFaceShiftVoxels;
+  report.binvoxVoxelSide = layout.voxelSide;
+}
+
+}  // namespace
+
 std::optional<VoxelFormat> voxelFormatFromPath(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
@@ -27,13 +48,9 @@ VoxelFileReport writeVoxelFile(const std::string& path, VoxelFormat format, cons
   VoxelFileReport report;
   OutputFile file(path);
   switch (format) {
-    case VoxelFormat::Binvox: {
-      const BinvoxLayout layout = writeBinvox(file.stream(), grid, progress);
-      report.voxels = countVoxels(grid);
-      report.binvoxShiftVoxels = layout.farFaceShiftVoxels;
-      report.binvoxVoxelSide = layout.voxelSide;
+    case VoxelFormat::Binvox:
+      writeBinvoxRows(file.stream(), grid, voxelRows(grid), progress, report);
       break;
-    }
     case VoxelFormat::MagicaVoxel: {
       const MagicaVoxelStats s = writeMagicaVoxel(file.stream(), grid, cellColors, kSolidCellColor, progress);
       report.voxels = s.voxels;
@@ -58,18 +75,7 @@ VoxelFileReport writeBinvoxFile(const std::string& path, const Grid& plan, const
                                 const std::function<void(double)>& progress) {
   VoxelFileReport report;
   OutputFile file(path);
-  // The voxels are counted on the writer's passes over the rows (each pass counts them all; the last count stands).
-  const VoxelRowSource counting = [&](const std::function<void(const VoxelRow&)>& visit) {
-    uint64_t voxels = 0;
-    rows([&](const VoxelRow& r) {
-      voxels += r.count;
-      visit(r);
-    });
-    report.voxels = voxels;
-  };
-  const BinvoxLayout layout = writeBinvox(file.stream(), plan, counting, progress);
-  report.binvoxShiftVoxels = layout.farFaceShiftVoxels;
-  report.binvoxVoxelSide = layout.voxelSide;
+  writeBinvoxRows(file.stream(), plan, rows, progress, report);
   file.commit();
   return report;
 }

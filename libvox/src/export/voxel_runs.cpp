@@ -60,6 +60,10 @@ void forEachVoxelRow(const Grid& grid, const std::function<void(const VoxelRow&)
   if (open) emitRows(grid, first, end, visit);
 }
 
+VoxelRowSource voxelRows(const Grid& grid) {
+  return [&grid](const std::function<void(const VoxelRow&)>& visit) { forEachVoxelRow(grid, visit); };
+}
+
 uint64_t countVoxels(const Grid& grid) {
   uint64_t n = 0;
   forEachVoxelRow(grid, [&](const VoxelRow& r) { n += r.count; });

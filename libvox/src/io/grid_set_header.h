@@ -2,6 +2,7 @@
 // magic, u32 version, u32 flags (0), u64 payload size, u64 checksum of the payload.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -24,6 +25,12 @@ Grid emptyGridLike(const Plan& plan) {
   g.dims = plan.dims;
   g.method = plan.method;
   return g;
+}
+
+// True when `name` holds a control byte (below 0x20, or DEL). Names are printed in one-line errors, which a newline
+// would split: readers refuse such names in a manifest, and the writer refuses to make them.
+inline bool hasControlByte(const std::string& name) {
+  return std::any_of(name.begin(), name.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; });
 }
 
 // The header's checksum field of a file's bytes (0 when too short).

@@ -34,10 +34,9 @@ std::string sceneFileName(const std::string& setPath) { return brickFolderName(s
 void makeBrickFolder(const std::string& setPath) {
   const auto folder = std::filesystem::path(setPath).parent_path() / brickFolderName(setPath);
   std::error_code ec;
-  // The manifest names the bricks by this folder, and readers refuse names with control bytes (they would split
-  // one-line errors): refuse them before writing a set no reader takes.
-  const std::string name = brickFolderName(setPath);
-  if (std::any_of(name.begin(), name.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; }))
+  // The manifest names the bricks by this folder, and readers refuse names with control bytes: refuse them before
+  // writing a set no reader takes.
+  if (hasControlByte(brickFolderName(setPath)))
     fail<OutputError>(quoteInput(setPath, 200), ": cannot write a grid set whose name holds control characters");
   // A device or FIFO can take a grid's bytes but not a set: its bricks would go into /dev.
   if (std::filesystem::exists(setPath, ec) && !std::filesystem::is_regular_file(setPath, ec))

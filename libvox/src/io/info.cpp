@@ -237,7 +237,7 @@ void writeGridSetInfo(std::ostream& out, const std::string& setPath, const InfoO
   const GridSetManifest m = readGridSetManifest(setPath);
   const GridFile sceneFile = readGridSetScene(setPath, m);
   writeInfo(out, sceneFile.scene, sceneFile.grid, options,
-            [&](const auto& visit, bool ordered) { 
+            [&](const auto& visit, bool ordered) {
               forEachGridSetLayer(setPath, m, sceneFile, visit, ordered ? LayerCells::Sorted : LayerCells::BrickOrder);
             });
 }

@@ -28,6 +28,8 @@ void forEachVoxelRow(const Grid& grid, const std::function<void(const VoxelRow&)
 // (a grid in memory, or a grid set read one layer of bricks at a time, which gives the same rows: a layer holds
 // whole z planes, and rows never leave their plane). Writers that need several passes call it several times.
 using VoxelRowSource = std::function<void(const std::function<void(const VoxelRow&)>& visit)>;
+// The rows of a grid in memory (forEachVoxelRow) as a source; `grid` must outlive it.
+VoxelRowSource voxelRows(const Grid& grid);
 
 // Number of distinct voxels (occupied or solid), counted from the runs. Same checks as forEachVoxelRow.
 uint64_t countVoxels(const Grid& grid);

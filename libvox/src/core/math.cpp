@@ -93,8 +93,10 @@ Mat4 rotation(const Vec3& axis, double degrees) {
   const Vec3 a = normalize(axis);
   const double turns = degrees / 90.0;
   double c, s;
-  if (turns == std::round(turns)) {
-    const int q = ((int(std::round(turns)) % 4) + 4) % 4;
+  // fmod keeps the quarter turn exact for any whole number of turns; an int cast overflows past 2^31 turns.
+  if (std::isfinite(turns) && turns == std::round(turns)) {
+    const double quarter = std::fmod(turns, 4.0);
+    const int q = int(quarter < 0 ? quarter + 4 : quarter);
     const double cs[4] = {1, 0, -1, 0}, sn[4] = {0, 1, 0, -1};
     c = cs[q];
     s = sn[q];

@@ -12,8 +12,9 @@ build=$(cd "$1" && pwd)
 seconds=$2
 targets=(course obj ply gltf glb grid)
 
+# -O1 -gline-tables-only, as OSS-Fuzz builds: about half the compile time of -O2 -g, and reports keep file:line.
 CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVOX_FUZZ=ON \
-  -DVOX_TESTS=OFF >/dev/null
+  "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only -DNDEBUG" -DVOX_TESTS=OFF >/dev/null
 ninja -C "$build" -j"$(nproc)" "${targets[@]/#/fuzz_}" vox-voxelize vox-export
 
 run=$build/fuzz-run

@@ -263,6 +263,49 @@ TEST(GridSet, StreamedInfoEqualsTheSingleGrids) {
   }
 }
 
+// The layers as the voxel formats read them: sorted keys alone (binvox, .vox without colours) or sorted keys with
+// their primitive counts (.vox by count), never a primitive list; one layer per bz, together the single grid's.
+TEST(GridSet, LayersOfKeysAndCountsAreTheSingleGrids) {
+  testing::ScratchDir dir("gridset_layers");
+  const FilledBox box = filledBox();
+  std::vector<uint64_t> wantCounts;
+  for (size_t c = 0; c < box.grid.occupiedCount(); ++c) wantCounts.push_back(box.grid.cellPrims(c).size());
+  for (const auto bricks : {std::array<uint32_t, 3>{1, 1, 1}, {3, 2, 4}, {2, 8, 1}, {9, 8, 7}}) {
+    const std::string path = writeFilledBoxSet(dir, "l", box, bricks);
+    const GridSetManifest m = readGridSetManifest(path);
+    const GridFile sceneFile = readGridSetScene(path, m);
+    for (const LayerCells cells : {LayerCells::KeysOnly, LayerCells::KeysAndCounts}) {
+      const std::string what = std::to_string(bricks[0]) + "x" + std::to_string(bricks[1]) + "x" +
+                               std::to_string(bricks[2]) + (cells == LayerCells::KeysOnly ? " keys" : " counts");
+      Grid joined;
+      std::vector<uint64_t> counts;
+      uint32_t layers = 0;
+      forEachGridSetLayer(
+          path, m, sceneFile,
+          [&](const Grid& layer) {
+            ++layers;
+            EXPECT_TRUE(layer.primIds.empty()) << what;  // no primitive list is kept
+            EXPECT_EQ(layer.cellStart.size(), cells == LayerCells::KeysOnly ? 0 : layer.cellKeys.size() + 1) << what;
+            for (size_t c = 0; c + 1 < layer.cellStart.size(); ++c)
+              counts.push_back(layer.cellStart[c + 1] - layer.cellStart[c]);
+            joined.cellKeys.insert(joined.cellKeys.end(), layer.cellKeys.begin(), layer.cellKeys.end());
+            for (const CellRun& r : layer.solidRuns) appendSolidRun(joined.solidRuns, r);
+          },
+          cells);
+      EXPECT_EQ(layers, bricks[2]) << what;
+      EXPECT_EQ(joined.cellKeys, box.grid.cellKeys) << what;
+      if (cells == LayerCells::KeysAndCounts) {
+        EXPECT_EQ(counts, wantCounts) << what;
+      }
+      ASSERT_EQ(joined.solidRuns.size(), box.grid.solidRuns.size()) << what;
+      for (size_t r = 0; r < joined.solidRuns.size(); ++r) {
+        EXPECT_EQ(joined.solidRuns[r].first, box.grid.solidRuns[r].first) << what;
+        EXPECT_EQ(joined.solidRuns[r].count, box.grid.solidRuns[r].count) << what;
+      }
+    }
+  }
+}
+
 // vox-export writes binvox from a set's layers of bricks, keys only (LayerCells::KeysOnly), instead of assembling
 // it: the file is the single grid's, byte for byte, with solid runs crossing bricks (fill) and bricks of one cell.
 TEST(GridSet, BinvoxFromLayersEqualsTheSingleGrids) {

@@ -91,15 +91,15 @@ uint32_t majorityMaterialColor(const Grid& grid, const Scene& scene, size_t cell
 }
 
 // The packed colour of each occupied cell (kNoColor for ColorMode::None); shared by the meshes and by
-// occupiedCellColors (the voxel formats), so a cell has one colour in every export.
-std::vector<uint32_t> occupiedColors(const Grid& grid, const Scene& scene, ColorMode mode) {
+// occupiedCellColors (the voxel formats), so a cell has one colour in every export. Count reads only cellStart,
+// against maxCount (0: the grid's own largest count).
+std::vector<uint32_t> occupiedColors(const Grid& grid, const Scene& scene, ColorMode mode, uint32_t maxCount = 0) {
   const size_t nOcc = grid.cellKeys.size();
-  if (grid.cellStart.size() != nOcc + 1 || grid.cellStart.back() > grid.primIds.size())
+  if (grid.cellStart.size() != nOcc + 1 || (mode != ColorMode::Count && grid.cellStart.back() > grid.primIds.size()))
     fail<InputError>("grid: inconsistent cell table (", nOcc, " cells, ", grid.cellStart.size(), " offsets)");
   std::vector<uint32_t> occColor(nOcc, kNoColor);
   if (mode == ColorMode::Count) {
-    uint32_t maxCount = 0;
-    for (size_t c = 0; c < nOcc; ++c) maxCount = std::max<uint32_t>(maxCount, uint32_t(grid.cellStart[c + 1] - grid.cellStart[c]));
+    if (maxCount == 0) maxCount = largestCellCount(grid);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nOcc), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t c = r.begin(); c != r.end(); ++c)
         occColor[c] = packColor(toRgb8(countColor(uint32_t(grid.cellStart[c + 1] - grid.cellStart[c]), maxCount)));
@@ -992,9 +992,16 @@ VoxelMesh triangulateVoxelMesh(const VoxelMesh& mesh) {
   return out;
 }
 
-std::vector<Rgb8> occupiedCellColors(const Grid& grid, const Scene& scene, ColorMode color) {
+uint32_t largestCellCount(const Grid& grid) {
+  uint32_t n = 0;
+  for (size_t c = 0; c + 1 < grid.cellStart.size(); ++c)
+    n = std::max<uint32_t>(n, uint32_t(grid.cellStart[c + 1] - grid.cellStart[c]));
+  return n;
+}
+
+std::vector<Rgb8> occupiedCellColors(const Grid& grid, const Scene& scene, ColorMode color, uint32_t maxCount) {
   if (color == ColorMode::None) return {};
-  const std::vector<uint32_t> packed = occupiedColors(grid, scene, color);
+  const std::vector<uint32_t> packed = occupiedColors(grid, scene, color, maxCount);
   std::vector<Rgb8> colors(packed.size());
   for (size_t c = 0; c < packed.size(); ++c) colors[c] = unpackColor(packed[c]);
   return colors;

@@ -175,22 +175,29 @@ namespace {
 // Appends a brick's cells to `whole`; the caller sorts when bricks interleave.
 void appendBrick(Grid& whole, const Grid& brick) {
   whole.cellKeys.insert(whole.cellKeys.end(), brick.cellKeys.begin(), brick.cellKeys.end());
-  const uint64_t base = whole.primIds.size();
+  const uint64_t base = whole.cellStart.back();  // primIds.size(), unless the lists were dropped (KeysAndCounts)
   for (size_t c = 1; c < brick.cellStart.size(); ++c) whole.cellStart.push_back(base + brick.cellStart[c]);
   whole.primIds.insert(whole.primIds.end(), brick.primIds.begin(), brick.primIds.end());
   whole.solidRuns.insert(whole.solidRuns.end(), brick.solidRuns.begin(), brick.solidRuns.end());
 }
 
-// Solid runs sorted and merged where they touch; with `cells`, cells sorted by key (bricks side by side along x or y
-// interleave).
-void sortLayer(Grid& grid, bool cells = true) {
+// Solid runs sorted and merged where they touch; cells sorted by key (bricks side by side along x or y interleave)
+// unless `cells` is BrickOrder, with their primitive lists (Sorted) or only their counts (KeysAndCounts: cellStart
+// without primIds), or keys alone (KeysOnly: cellStart emptied).
+void sortLayer(Grid& grid, LayerCells cells) {
   std::sort(grid.solidRuns.begin(), grid.solidRuns.end(),
             [](const CellRun& a, const CellRun& b) { return a.first < b.first; });
   std::vector<CellRun> runs;
   runs.reserve(grid.solidRuns.size());
   for (const CellRun& r : grid.solidRuns) appendSolidRun(runs, r);
   grid.solidRuns = std::move(runs);
-  if (!cells || std::is_sorted(grid.cellKeys.begin(), grid.cellKeys.end())) return;
+  if (cells == LayerCells::KeysOnly) {
+    std::sort(grid.cellKeys.begin(), grid.cellKeys.end());
+    grid.cellStart.clear();
+    return;
+  }
+  if (cells == LayerCells::BrickOrder || std::is_sorted(grid.cellKeys.begin(), grid.cellKeys.end())) return;
+  const bool lists = cells == LayerCells::Sorted;
   const size_t n = grid.occupiedCount();
   std::vector<uint32_t> order(n);
   for (size_t c = 0; c < n; ++c) order[c] = uint32_t(c);
@@ -198,12 +205,14 @@ void sortLayer(Grid& grid, bool cells = true) {
   Grid sorted;
   sorted.cellKeys.reserve(n);
   sorted.cellStart.reserve(n + 1);
-  sorted.primIds.reserve(grid.primIds.size());
+  if (lists) sorted.primIds.reserve(grid.primIds.size());
   for (uint32_t c : order) {
     sorted.cellKeys.push_back(grid.cellKeys[c]);
-    const auto prims = grid.cellPrims(c);
-    sorted.primIds.insert(sorted.primIds.end(), prims.begin(), prims.end());
-    sorted.cellStart.push_back(sorted.primIds.size());
+    if (lists) {
+      const auto prims = grid.cellPrims(c);
+      sorted.primIds.insert(sorted.primIds.end(), prims.begin(), prims.end());
+    }
+    sorted.cellStart.push_back(sorted.cellStart.back() + (grid.cellStart[c + 1] - grid.cellStart[c]));
   }
   grid.cellKeys = std::move(sorted.cellKeys);
   grid.cellStart = std::move(sorted.cellStart);
@@ -219,18 +228,13 @@ void forEachGridSetLayer(const std::string& setPath, const GridSetManifest& m, c
     Grid layer = emptyGridLike(sceneFile.grid);
     for (; i < m.entries.size() && m.entries[i].index[2] == bz; ++i) {
       Grid brick = readBrick(setPath, m, i, sceneFile.scene.boundedCount());
-      if (cells == LayerCells::KeysOnly) {
-        brick.cellStart = {0};
+      if (cells == LayerCells::KeysOnly) brick.cellStart = {0};
+      if (cells == LayerCells::KeysOnly || cells == LayerCells::KeysAndCounts)
         std::vector<uint32_t>().swap(brick.primIds);
-      }
       appendBrick(layer, brick);
     }
     if (layer.cellKeys.size() > UINT32_MAX) fail<LimitError>(setPath, ": a layer of bricks holds more than 2^32 cells");
-    sortLayer(layer, cells == LayerCells::Sorted);
-    if (cells == LayerCells::KeysOnly) {
-      std::sort(layer.cellKeys.begin(), layer.cellKeys.end());
-      layer.cellStart.clear();
-    }
+    sortLayer(layer, cells);
     visit(layer);
   }
 }
@@ -259,7 +263,7 @@ GridFile readGridSet(const std::string& path) {
   g.cellStart.reserve(occupied + 1);
   g.primIds.reserve(references);
   for (size_t i = 0; i < m.entries.size(); ++i) appendBrick(g, readBrick(path, m, i, whole.scene.boundedCount()));
-  sortLayer(g);
+  sortLayer(g, LayerCells::Sorted);
   return whole;
 }
 

@@ -37,9 +37,15 @@ using Rgb8 = std::array<uint8_t, 3>;
 inline constexpr Rgb8 kSolidCellColor{153, 153, 153};
 
 // The display colour of each occupied cell (grid.cellKeys order) under `color`, as buildVoxelMesh paints its faces
-// (for the voxel formats, which colour cells rather than faces); empty for ColorMode::None. Throws InputError like
-// buildVoxelMesh for an inconsistent cell table or a primitive or material out of range.
-std::vector<Rgb8> occupiedCellColors(const Grid& grid, const Scene& scene, ColorMode color);
+// (for the voxel formats, which colour cells rather than faces); empty for ColorMode::None. Count: the ramp ends
+// at `maxCount`, 0 meaning largestCellCount(grid); a piece of a larger grid (a layer of a grid set) passes the whole
+// grid's, so its cells get the whole grid's colours. Count reads only cellStart, so primIds may be empty
+// (LayerCells::KeysAndCounts). Throws InputError like buildVoxelMesh for an inconsistent cell table or a primitive
+// or material out of range.
+std::vector<Rgb8> occupiedCellColors(const Grid& grid, const Scene& scene, ColorMode color, uint32_t maxCount = 0);
+
+// The largest number of primitives in one occupied cell of `grid` (from cellStart only); 0 without cells.
+uint32_t largestCellCount(const Grid& grid);
 
 // A polygon mesh of plain arrays. Positions are world space (the grid's frame), on the grid lattice given by
 // cellBoundary. Face f has the vertices faceVertices[faceStart[f] .. faceStart[f+1]), counter-clockwise seen from

@@ -119,9 +119,11 @@ Grid decodeBrickFile(const std::string& bytes, const std::string& name, const Gr
 Grid readBrick(const std::string& setPath, const GridSetManifest& manifest, size_t entry, uint64_t boundedCount);
 
 // What forEachGridSetLayer hands over of a layer's cells: sorted by key with their primitive lists (vox-info
-// --cells), in brick order with their lists (totals, which need no order), or sorted keys alone, cellStart and
-// primIds left empty (voxel rows, for binvox: no primitive list is kept or moved).
-enum class LayerCells : uint8_t { Sorted, BrickOrder, KeysOnly };
+// --cells), in brick order with their lists (totals, which need no order), sorted keys alone, cellStart and
+// primIds left empty (voxel rows, for binvox: no primitive list is kept or moved), or sorted keys with their
+// primitive counts: cellStart as if the lists were there (cell c holds cellStart[c + 1] - cellStart[c]
+// primitives) but primIds left empty (.vox colours by count: 8 bytes a cell more than the keys, no lists).
+enum class LayerCells : uint8_t { Sorted, BrickOrder, KeysOnly, KeysAndCounts };
 
 // Streams a set in cell-key order, one layer of bricks at a time (all bricks with one bz: cells are ordered x
 // fastest, so the cells of a layer's bricks interleave): `visit` gets each layer's cells as `cells` says and its

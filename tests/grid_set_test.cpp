@@ -7,12 +7,12 @@
 
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <sstream>
 
 #include "test_util.h"
 #include "vox/core/error.h"
-#include "vox/export/binvox_writer.h"
-#include "vox/export/voxel_runs.h"
+#include "vox/export/voxel_format.h"
 #include "vox/io/atomic_file.h"
 #include "vox/io/info.h"
 #include "vox/io/input_file.h"
@@ -306,33 +306,86 @@ TEST(GridSet, LayersOfKeysAndCountsAreTheSingleGrids) {
   }
 }
 
-// vox-export writes binvox from a set's layers of bricks, keys only (LayerCells::KeysOnly), instead of assembling
-// it: the file is the single grid's, byte for byte, with solid runs crossing bricks (fill) and bricks of one cell.
-TEST(GridSet, BinvoxFromLayersEqualsTheSingleGrids) {
-  testing::ScratchDir dir("gridset_binvox");
-  const FilledBox box = filledBox();
-  std::ostringstream want;
-  writeBinvox(want, box.grid);
-  for (const auto bricks : {std::array<uint32_t, 3>{1, 1, 1}, {3, 2, 4}, {2, 8, 1}, {9, 8, 7}}) {
-    const std::string path = writeFilledBoxSet(dir, "b", box, bricks);
-    const GridSetManifest m = readGridSetManifest(path);
-    const GridFile sceneFile = readGridSetScene(path, m);
-    int layers = 0;
-    const VoxelRowSource rows = [&](const std::function<void(const VoxelRow&)>& visit) {
-      forEachGridSetLayer(
-          path, m, sceneFile,
-          [&](const Grid& layer) {
-            EXPECT_TRUE(layer.primIds.empty());  // no primitive list is kept
-            ++layers;
-            forEachVoxelRow(layer, visit);
-          },
-          LayerCells::KeysOnly);
-    };
-    std::ostringstream got;
-    writeBinvox(got, sceneFile.grid, rows);
-    EXPECT_EQ(got.str(), want.str()) << bricks[0] << "x" << bricks[1] << "x" << bricks[2] << " bricks";
-    EXPECT_EQ(layers, 2 * int(bricks[2]));  // two passes, a layer at a time
+// `n` small triangles scattered over the unit cube, each of its own material and colour: more than 255 voxel
+// colours, so a .vox palette is reduced by median cut, weighted by the voxels of every colour.
+Scene manyColorScene(int n) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.05, 0.95), d(-0.04, 0.04), c(0, 1);
+  Scene scene;
+  for (int i = 0; i < n; ++i) {
+    Material mat;
+    mat.diffuse = {c(rng), c(rng), c(rng)};
+    scene.materials.push_back(mat);
+    const Vec3 p{u(rng), u(rng), u(rng)};
+    Triangle t;
+    for (Vec3& v : t.v) v = p + Vec3{d(rng), d(rng), d(rng)};
+    t.material = uint32_t(i);
+    scene.triangles.push_back(t);
   }
+  return scene;
+}
+
+// vox-export writes binvox and .vox from a set's layers of bricks (writeGridSetVoxelFile) instead of assembling it:
+// each file and report is the single grid's, byte for byte, in every colour mode, with solid runs crossing bricks
+// (fill), bricks of one cell, layers of several bricks, a grid of several 256^3 models on x and z whose layers are
+// thinner than a model's slab or straddle two, and a palette reduced from the colours of every layer.
+TEST(GridSet, VoxelFilesFromLayersEqualTheSingleGrids) {
+  testing::ScratchDir dir("gridset_voxelfiles");
+  const FilledBox small = filledBox();
+  FilledBox thick;
+  thick.options.dims = std::array<uint32_t, 3>{400, 5, 520};
+  thick.options.bounds = small.options.bounds;
+  thick.grid = voxelizeScene(thick.scene, thick.options);
+  fillSolid(thick.grid, thick.scene);
+  FilledBox colorful;  // not filled: its triangles enclose nothing
+  colorful.scene = manyColorScene(400);
+  colorful.options.dims = std::array<uint32_t, 3>{24, 22, 20};
+  colorful.options.bounds = small.options.bounds;
+  colorful.grid = voxelizeScene(colorful.scene, colorful.options);
+  struct Case {
+    const char* name;
+    const FilledBox* box;
+    bool fill;
+    std::vector<std::array<uint32_t, 3>> bricks;
+  };
+  const Case cases[] = {{"box", &small, true, {{1, 1, 1}, {3, 2, 4}, {2, 8, 1}, {9, 8, 7}}},
+                        {"thick box", &thick, true, {{1, 1, 1}, {2, 1, 3}, {1, 2, 7}}},
+                        {"colourful", &colorful, false, {{1, 1, 1}, {2, 3, 4}}}};
+  bool reduced = false;
+  for (const Case& c : cases) {
+    for (const auto& bricks : c.bricks) {
+      const std::string path = dir.file("v.vgrid");
+      std::filesystem::remove_all(dir.file("v.bricks"));
+      const FillOptions fo;
+      writeGridSet(path, c.box->scene, c.box->options, bricks, nullptr, c.fill ? &fo : nullptr);
+      const GridSetManifest m = readGridSetManifest(path);
+      const GridFile sceneFile = readGridSetScene(path, m);
+      for (const VoxelFormat format : {VoxelFormat::Binvox, VoxelFormat::MagicaVoxel}) {
+        for (const ColorMode color : {ColorMode::Count, ColorMode::Material, ColorMode::None}) {
+          if (format == VoxelFormat::Binvox && color != ColorMode::Count) continue;  // binvox has no colour
+          const std::string what = std::string(c.name) + " in " + std::to_string(bricks[0]) + "x" +
+                                   std::to_string(bricks[1]) + "x" + std::to_string(bricks[2]) + " bricks, " +
+                                   colorModeName(color) + (format == VoxelFormat::Binvox ? ", binvox" : ", vox");
+          const std::vector<Rgb8> colors =
+              format == VoxelFormat::MagicaVoxel ? occupiedCellColors(c.box->grid, c.box->scene, color)
+                                                 : std::vector<Rgb8>{};
+          const VoxelFileReport want = writeVoxelFile(dir.file("want"), format, c.box->grid, colors);
+          const VoxelFileReport got = writeGridSetVoxelFile(dir.file("got"), format, path, m, sceneFile, color);
+          EXPECT_EQ(slurp(dir.file("got")), slurp(dir.file("want"))) << what;
+          EXPECT_EQ(got.voxels, want.voxels) << what;
+          EXPECT_EQ(got.models, want.models) << what;
+          EXPECT_EQ(got.gridColors, want.gridColors) << what;
+          EXPECT_EQ(got.paletteColors, want.paletteColors) << what;
+          EXPECT_EQ(got.paletteReduced, want.paletteReduced) << what;
+          if (format == VoxelFormat::MagicaVoxel && c.box == &thick) {
+            EXPECT_EQ(got.models, 4u) << what;  // 2 x 1 x 2 tiles
+          }
+          reduced = reduced || got.paletteReduced;
+        }
+      }
+    }
+  }
+  EXPECT_TRUE(reduced);  // the weighted median cut was exercised
 }
 
 // Brick and scene files are untrusted: every truncation and bit flip of a brick is refused with its name, and a

@@ -82,12 +82,17 @@ for faces in all exposed merged; do
   check "export set $faces" 0 "$E" "$T/bbox_set.vgrid" -o "$T/b_$faces.ply" --faces $faces -q
   same "export $faces of set and grid" "$T/a_$faces.ply" "$T/b_$faces.ply"
 done
-# Voxel formats too; binvox is written from the set's layers of bricks, never assembled (vox-export). Not .vdb:
-# OpenVDB writes a new random UUID into every file's header.
+# Voxel formats too; binvox and .vox are written from the set's layers of bricks, never assembled (vox-export). Not
+# .vdb: OpenVDB writes a new random UUID into every file's header.
 for ext in binvox vox; do
   check "export $ext" 0 "$E" "$T/bbox.vgrid" -o "$T/a.$ext" -q
   check "export set $ext" 0 "$E" "$T/bbox_set.vgrid" -o "$T/b.$ext" -q
   same "export .$ext of set and grid" "$T/a.$ext" "$T/b.$ext"
+done
+for color in material none; do  # .vox by count above; by material the layers keep their primitive lists
+  check "export vox $color" 0 "$E" "$T/bbox.vgrid" -o "$T/a_$color.vox" --color $color -q
+  check "export set vox $color" 0 "$E" "$T/bbox_set.vgrid" -o "$T/b_$color.vox" --color $color -q
+  same "export .vox --color $color of set and grid" "$T/a_$color.vox" "$T/b_$color.vox"
 done
 
 # A scene of planes only: no occupied cell, no brick file; the set's scene file keeps the planes.
@@ -115,6 +120,9 @@ compare_fill() {  # compare_fill TAG SCENE "GRID ARGS" "BRICKS"
   check "$tag fill binvox" 0 "$E" "$T/$tag.vgrid" -o "$T/$tag.binvox" -q
   check "$tag fill set binvox" 0 "$E" "$T/${tag}_set.vgrid" -o "$T/${tag}_set.binvox" -q
   same "$tag: binvox of the filled set and grid" "$T/$tag.binvox" "$T/${tag}_set.binvox"
+  check "$tag fill vox" 0 "$E" "$T/$tag.vgrid" -o "$T/$tag.vox" -q
+  check "$tag fill set vox" 0 "$E" "$T/${tag}_set.vgrid" -o "$T/${tag}_set.vox" -q
+  same "$tag: .vox of the filled set and grid" "$T/$tag.vox" "$T/${tag}_set.vox"
 }
 compare_fill fill_bunny "$S/scene5_07_bunny_mesh_1k.txt" "--grid 15 15 12" "7 5 3"
 compare_fill fill_bunny1 "$S/scene5_07_bunny_mesh_1k.txt" "--grid 15 15 12" "1 1 1"

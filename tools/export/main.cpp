@@ -12,7 +12,6 @@
 #include "vox/core/progress.h"
 #include "vox/export/voxel_mesh.h"
 #include "vox/export/voxel_format.h"
-#include "vox/export/voxel_runs.h"
 
 namespace {
 
@@ -38,9 +37,10 @@ int runVoxelFormat(const Options& opt, vox::VoxelFormat format) {
   checkOutputPath(opt.output, {opt.grid});
   const ColorMode color = parseColorMode(opt.color);
   ProgressBar bar("exporting", opt.common.quiet);
-  // binvox needs only the voxel rows in key order: a set is then read one layer of bricks at a time, keys only (on
-  // each of the writer's two passes), instead of assembled, which keeps the peak memory to a layer (docs/scaling.md).
-  const bool layered = format == VoxelFormat::Binvox && isGridSet(opt.grid);
+  // binvox and .vox need only the voxels in key order (with each occupied cell's colour for .vox): a set is then
+  // read one layer of bricks at a time on each of the writer's passes instead of assembled, which keeps the peak
+  // memory to a layer (docs/scaling.md). .vdb builds OpenVDB's tree of the whole grid, so its set is assembled.
+  const bool layered = format != VoxelFormat::Vdb && isGridSet(opt.grid);
   GridSetManifest set;
   GridFile file;
   if (layered) {
@@ -56,17 +56,14 @@ int runVoxelFormat(const Options& opt, vox::VoxelFormat format) {
   }
   bar.update(0.1);
   std::vector<Rgb8> colors;
-  if (format == VoxelFormat::MagicaVoxel && color != ColorMode::None)
+  if (!layered && format == VoxelFormat::MagicaVoxel && color != ColorMode::None)
     colors = occupiedCellColors(file.grid, file.scene, color);
   bar.update(0.2);
   const auto writeStart = std::chrono::steady_clock::now();
   const auto progress = [&](double f) { bar.update(0.2 + 0.8 * f); };
-  const VoxelRowSource setRows = [&](const std::function<void(const VoxelRow&)>& visit) {
-    forEachGridSetLayer(
-        opt.grid, set, file, [&](const Grid& layer) { forEachVoxelRow(layer, visit); }, LayerCells::KeysOnly);
-  };
-  const VoxelFileReport report = layered ? writeBinvoxFile(opt.output, file.grid, setRows, progress)
-                                         : writeVoxelFile(opt.output, format, file.grid, colors, progress);
+  const VoxelFileReport report =
+      layered ? writeGridSetVoxelFile(opt.output, format, opt.grid, set, file, color, progress)
+              : writeVoxelFile(opt.output, format, file.grid, colors, progress);
   const double writeSeconds = secondsSince(writeStart);
   bar.finish();
   if (format == VoxelFormat::Binvox && report.binvoxShiftVoxels > 1e-9 && !opt.common.quiet)

@@ -1,7 +1,9 @@
-// MagicaVoxel writer (magicavoxel_writer.h). Two passes over the grid's voxel rows: the first counts the voxels of
-// every 256^3 tile (chunk sizes come before their content, and MAIN's size before everything), the second buffers
-// one 256-thick z slab of tiles at a time and writes their SIZE and XYZI chunks. Keys with k in one slab are one
-// contiguous key range, so the slab is complete when the rows move past it.
+// MagicaVoxel writer (magicavoxel_writer.h). Two passes over the voxel rows of the grid's pieces (the whole grid in
+// memory, or a grid set's layers of bricks): the first counts the voxels of every 256^3 tile (chunk sizes come
+// before their content, and MAIN's size before everything) and of every colour (the palette comes from all of
+// them), the second buffers one 256-thick z slab of tiles at a time and writes their SIZE and XYZI chunks. Keys with
+// k in one slab are one contiguous key range, so the slab is complete when the rows move past it, whatever the
+// pieces' thickness.
 #include "vox/export/magicavoxel_writer.h"
 
 #include <algorithm>
@@ -69,22 +71,57 @@ void splitRow(const Tiling& tiling, const VoxelRow& r, F&& piece) {
   }
 }
 
-std::map<uint64_t, Tile> countTiles(const Grid& grid, const Tiling& tiling) {
+// Calls onPiece(piece, colours) for every piece in order, then onRow(row) for each of its voxel rows; refuses colours
+// of the wrong count, and keys that do not ascend from one piece to the next (forEachVoxelRow checks them within).
+template <typename P, typename R>
+void forEachPieceRow(const ColoredPieceSource& pieces, P&& onPiece, R&& onRow) {
+  uint64_t next = 0;  // smallest key the next row may start at
+  pieces([&](const Grid& piece, std::span<const Rgb8> colors) {
+    if (!colors.empty() && colors.size() != piece.cellKeys.size())
+      fail<InputError>("vox: ", colors.size(), " cell colours for ", piece.cellKeys.size(), " occupied cells");
+    onPiece(piece, colors);
+    forEachVoxelRow(piece, [&](const VoxelRow& r) {
+      if (r.key < next)
+        fail<InputError>("vox: cell key ", r.key, " repeated or out of order between pieces of the grid");
+      next = r.key + r.count;
+      onRow(r);
+    });
+  });
+}
+
+// What the file's layout and palette need before anything is written: the voxels of every non-empty tile, and the
+// voxels of every colour (occupied cells by their colour, the rest by solidColor).
+struct Census {
   std::map<uint64_t, Tile> tiles;
-  forEachVoxelRow(grid, [&](const VoxelRow& r) {
+  std::unordered_map<uint32_t, uint64_t> weights;
+  uint64_t voxels = 0;
+  uint64_t solidOnly = 0;  // voxels without a cell colour
+};
+
+Census takeCensus(const Grid& plan, const Tiling& tiling, const ColoredPieceSource& pieces, Rgb8 solidColor) {
+  Census census;
+  uint64_t colored = 0;
+  const auto weigh = [&](const Grid&, std::span<const Rgb8> colors) {
+    for (const Rgb8& c : colors) ++census.weights[pack(c)];
+    colored += colors.size();
+  };
+  forEachPieceRow(pieces, weigh, [&](const VoxelRow& r) {
+    census.voxels += r.count;
     splitRow(tiling, r, [&](uint64_t key, uint32_t i, uint32_t n) {
-      Tile& t = tiles[key];
+      Tile& t = census.tiles[key];
       if (t.voxels == 0) {
         const std::array<uint32_t, 3> cell{i, r.j, r.k};
         for (int a = 0; a < 3; ++a) {
           t.origin[a] = cell[a] / kVoxModelSide * kVoxModelSide;
-          t.size[a] = std::min(kVoxModelSide, grid.dims[a] - t.origin[a]);
+          t.size[a] = std::min(kVoxModelSide, plan.dims[a] - t.origin[a]);
         }
       }
       t.voxels += n;
     });
   });
-  return tiles;
+  census.solidOnly = census.voxels - colored;
+  if (census.solidOnly > 0) census.weights[pack(solidColor)] += census.solidOnly;
+  return census;
 }
 
 std::string dict(const std::vector<std::pair<std::string, std::string>>& entries) {
@@ -165,6 +202,60 @@ PaletteMap buildPalette(const std::unordered_map<uint32_t, uint64_t>& weights) {
   return map;
 }
 
+// The second pass: the pieces' voxels, one 256-thick z slab of tiles at a time, as each tile's SIZE and XYZI chunks
+// (`buf` holds what precedes the first chunk and is written with it).
+void writeModels(std::ostream& out, std::string& buf, const Grid& plan, const Tiling& tiling,
+                 const std::map<uint64_t, Tile>& tiles, const ColoredPieceSource& pieces, const PaletteMap& palette,
+                 uint8_t solidIndex, const std::function<void(double)>& progress) {
+  std::unordered_map<uint64_t, std::vector<uint32_t>> slab;  // tile key -> packed x | y << 8 | z << 16 | i << 24
+  int64_t slabZ = -1;
+  auto flushSlab = [&] {
+    for (auto it = tiles.lower_bound(tiling.key(0, 0, uint64_t(slabZ)));
+         it != tiles.end() && int64_t(it->second.origin[2]) == slabZ; ++it) {
+      const Tile& t = it->second;
+      const std::vector<uint32_t>& v = slab[it->first];
+      VOX_CHECK(v.size() == t.voxels);
+      putChunkHeader(buf, "SIZE", 12, 0);
+      for (int a = 0; a < 3; ++a) putU32(buf, t.size[a]);
+      putChunkHeader(buf, "XYZI", 4 + 4 * v.size(), 0);
+      putU32(buf, uint32_t(v.size()));
+      out.write(buf.data(), std::streamsize(buf.size()));
+      buf.clear();
+      out.write(reinterpret_cast<const char*>(v.data()), std::streamsize(4 * v.size()));  // little-endian host
+    }
+    slab.clear();
+  };
+  // The palette index of each occupied cell of the current piece, and the cell the rows have reached.
+  const std::vector<uint64_t>* keys = nullptr;
+  std::vector<uint8_t> cellIndex;
+  size_t a = 0;
+  const auto startPiece = [&](const Grid& piece, std::span<const Rgb8> colors) {
+    keys = &piece.cellKeys;
+    cellIndex.resize(colors.size());
+    for (size_t c = 0; c < colors.size(); ++c) cellIndex[c] = palette.index.at(pack(colors[c]));
+    a = 0;
+  };
+  forEachPieceRow(pieces, startPiece, [&](const VoxelRow& r) {
+    const int64_t z0 = r.k / kVoxModelSide * kVoxModelSide;
+    if (z0 != slabZ) {
+      if (slabZ >= 0) flushSlab();
+      slabZ = z0;
+      if (progress) progress(double(r.k) / double(plan.dims[2]));
+    }
+    const size_t nOcc = keys->size();
+    splitRow(tiling, r, [&](uint64_t key, uint32_t i0, uint32_t n) {
+      std::vector<uint32_t>& v = slab[key];
+      const uint32_t yz = ((r.j % kVoxModelSide) << 8) | ((r.k % kVoxModelSide) << 16);
+      for (uint64_t cell = r.key + (i0 - r.i0), end = cell + n; cell < end; ++cell) {
+        while (a < nOcc && (*keys)[a] < cell) ++a;
+        const uint8_t index = a < nOcc && (*keys)[a] == cell && !cellIndex.empty() ? cellIndex[a] : solidIndex;
+        v.push_back(uint32_t(cell - r.key + r.i0) % kVoxModelSide | yz | (uint32_t(index) << 24));
+      }
+    });
+  });
+  if (slabZ >= 0) flushSlab();
+}
+
 }  // namespace
 
 std::vector<Rgb8> choosePalette(std::span<const Rgb8> colors, std::span<const uint64_t> weights) {
@@ -226,18 +317,22 @@ std::vector<Rgb8> choosePalette(std::span<const Rgb8> colors, std::span<const ui
 
 MagicaVoxelStats writeMagicaVoxel(std::ostream& out, const Grid& grid, std::span<const Rgb8> cellColors,
                                   Rgb8 solidColor, const std::function<void(double)>& progress) {
-  const size_t nOcc = grid.cellKeys.size();
-  if (!cellColors.empty() && cellColors.size() != nOcc)
-    fail<InputError>("vox: ", cellColors.size(), " cell colours for ", nOcc, " occupied cells");
-  const Tiling tiling{(grid.dims[0] + kVoxModelSide - 1) / kVoxModelSide,
-                      (grid.dims[1] + kVoxModelSide - 1) / kVoxModelSide};
-  const std::map<uint64_t, Tile> tiles = countTiles(grid, tiling);  // also checks the keys and runs
+  const ColoredPieceSource whole = [&](const ColoredPieceVisitor& visit) { visit(grid, cellColors); };
+  return writeMagicaVoxelPieces(out, grid, whole, solidColor, progress);
+}
+
+MagicaVoxelStats writeMagicaVoxelPieces(std::ostream& out, const Grid& plan, const ColoredPieceSource& pieces,
+                                        Rgb8 solidColor, const std::function<void(double)>& progress) {
+  const Tiling tiling{(plan.dims[0] + kVoxModelSide - 1) / kVoxModelSide,
+                      (plan.dims[1] + kVoxModelSide - 1) / kVoxModelSide};
+  const Census census = takeCensus(plan, tiling, pieces, solidColor);  // also checks the keys and runs
+  const std::map<uint64_t, Tile>& tiles = census.tiles;
   MagicaVoxelStats stats;
   stats.models = uint32_t(tiles.size());
+  stats.voxels = census.voxels;
   uint64_t children = 0, slabMax = 0;
   std::map<uint32_t, uint64_t> slabVoxels;
   for (const auto& [key, t] : tiles) {
-    stats.voxels += t.voxels;
     children += 24 + 16 + 4 * t.voxels;  // SIZE chunk, XYZI chunk
     slabVoxels[t.origin[2]] += t.voxels;
   }
@@ -249,58 +344,16 @@ MagicaVoxelStats writeMagicaVoxel(std::ostream& out, const Grid& grid, std::span
                      "format's int32 chunk sizes allow (export a coarser grid or several bricks)");
   checkMemory(double(slabMax) * 4, "vox", "one 256-cell slab of voxels");
 
-  // Colours, weighted by voxels.
-  std::unordered_map<uint32_t, uint64_t> weights;
-  for (const Rgb8& c : cellColors) ++weights[pack(c)];
-  const uint64_t solidOnly = stats.voxels - (cellColors.empty() ? 0 : nOcc);
-  if (solidOnly > 0) weights[pack(solidColor)] += solidOnly;
-  const PaletteMap palette = buildPalette(weights);
-  stats.gridColors = uint32_t(weights.size());
+  const PaletteMap palette = buildPalette(census.weights);
+  stats.gridColors = uint32_t(census.weights.size());
   stats.paletteColors = uint32_t(palette.palette.size());
-  stats.paletteReduced = weights.size() > 255;
-  std::vector<uint8_t> cellIndex(cellColors.size());
-  for (size_t c = 0; c < cellColors.size(); ++c) cellIndex[c] = palette.index.at(pack(cellColors[c]));
-  const uint8_t solidIndex = solidOnly > 0 ? palette.index.at(pack(solidColor)) : 1;
+  stats.paletteReduced = census.weights.size() > 255;
+  const uint8_t solidIndex = census.solidOnly > 0 ? palette.index.at(pack(solidColor)) : 1;
 
   std::string buf = "VOX ";
   putU32(buf, 150);
   putChunkHeader(buf, "MAIN", 0, children);
-  std::unordered_map<uint64_t, std::vector<uint32_t>> slab;  // tile key -> packed x | y << 8 | z << 16 | i << 24
-  int64_t slabZ = -1;
-  auto flushSlab = [&] {
-    for (auto it = tiles.lower_bound(tiling.key(0, 0, uint64_t(slabZ))); it != tiles.end() && int64_t(it->second.origin[2]) == slabZ; ++it) {
-      const Tile& t = it->second;
-      const std::vector<uint32_t>& v = slab[it->first];
-      VOX_CHECK(v.size() == t.voxels);
-      putChunkHeader(buf, "SIZE", 12, 0);
-      for (int a = 0; a < 3; ++a) putU32(buf, t.size[a]);
-      putChunkHeader(buf, "XYZI", 4 + 4 * v.size(), 0);
-      putU32(buf, uint32_t(v.size()));
-      out.write(buf.data(), std::streamsize(buf.size()));
-      buf.clear();
-      out.write(reinterpret_cast<const char*>(v.data()), std::streamsize(4 * v.size()));  // little-endian host
-    }
-    slab.clear();
-  };
-  size_t a = 0;
-  forEachVoxelRow(grid, [&](const VoxelRow& r) {
-    const int64_t z0 = r.k / kVoxModelSide * kVoxModelSide;
-    if (z0 != slabZ) {
-      if (slabZ >= 0) flushSlab();
-      slabZ = z0;
-      if (progress) progress(double(r.k) / double(grid.dims[2]));
-    }
-    splitRow(tiling, r, [&](uint64_t key, uint32_t i0, uint32_t n) {
-      std::vector<uint32_t>& v = slab[key];
-      const uint32_t yz = ((r.j % kVoxModelSide) << 8) | ((r.k % kVoxModelSide) << 16);
-      for (uint64_t cell = r.key + (i0 - r.i0), end = cell + n; cell < end; ++cell) {
-        while (a < nOcc && grid.cellKeys[a] < cell) ++a;
-        const uint8_t index = a < nOcc && grid.cellKeys[a] == cell && !cellIndex.empty() ? cellIndex[a] : solidIndex;
-        v.push_back(uint32_t(cell - r.key + r.i0) % kVoxModelSide | yz | (uint32_t(index) << 24));
-      }
-    });
-  });
-  if (slabZ >= 0) flushSlab();
+  writeModels(out, buf, plan, tiling, tiles, pieces, palette, solidIndex, progress);
   buf += graph;
   putChunkHeader(buf, "RGBA", 1024, 0);
   for (size_t p = 0; p < 256; ++p) {

@@ -1,4 +1,5 @@
-// Voxel file formats (voxel_format.h): extension dispatch over the three writers.
+// Voxel file formats (voxel_format.h): extension dispatch over the three writers, and binvox and .vox written from
+// a grid set's layers of bricks.
 #include "vox/export/voxel_format.h"
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include "vox/export/magicavoxel_writer.h"
 #include "vox/export/vdb_writer.h"
 #include "vox/export/voxel_runs.h"
+#include "vox/core/error.h"
 #include "vox/io/atomic_file.h"
 
 namespace vox {
@@ -32,6 +34,33 @@ void writeBinvoxRows(std::ostream& out, const Grid& plan, const VoxelRowSource& 
   report.binvoxVoxelSide = layout.voxelSide;
 }
 
+void reportVox(const MagicaVoxelStats& s, VoxelFileReport& report) {
+  report.voxels = s.voxels;
+  report.models = s.models;
+  report.gridColors = s.gridColors;
+  report.paletteColors = s.paletteColors;
+  report.paletteReduced = s.paletteReduced;
+}
+
+// A set's layers as .vox pieces, each with its cells' colours. By count, the ramp's top is the whole set's largest
+// count, found on a pass of its own: the colours of the first layer depend on cells of the last.
+ColoredPieceSource setPieces(const std::string& setPath, const GridSetManifest& set, const GridFile& sceneFile,
+                             ColorMode color) {
+  const LayerCells cells = color == ColorMode::Count      ? LayerCells::KeysAndCounts
+                           : color == ColorMode::Material ? LayerCells::Sorted
+                                                          : LayerCells::KeysOnly;
+  uint32_t maxCount = 0;
+  if (color == ColorMode::Count)
+    forEachGridSetLayer(
+        setPath, set, sceneFile, [&](const Grid& layer) { maxCount = std::max(maxCount, largestCellCount(layer)); },
+        cells);
+  return [&setPath, &set, &sceneFile, color, cells, maxCount](const ColoredPieceVisitor& visit) {
+    forEachGridSetLayer(
+        setPath, set, sceneFile,
+        [&](const Grid& layer) { visit(layer, occupiedCellColors(layer, sceneFile.scene, color, maxCount)); }, cells);
+  };
+}
+
 }  // namespace
 
 std::optional<VoxelFormat> voxelFormatFromPath(const std::string& path) {
@@ -51,15 +80,9 @@ VoxelFileReport writeVoxelFile(const std::string& path, VoxelFormat format, cons
     case VoxelFormat::Binvox:
       writeBinvoxRows(file.stream(), grid, voxelRows(grid), progress, report);
       break;
-    case VoxelFormat::MagicaVoxel: {
-      const MagicaVoxelStats s = writeMagicaVoxel(file.stream(), grid, cellColors, kSolidCellColor, progress);
-      report.voxels = s.voxels;
-      report.models = s.models;
-      report.gridColors = s.gridColors;
-      report.paletteColors = s.paletteColors;
-      report.paletteReduced = s.paletteReduced;
+    case VoxelFormat::MagicaVoxel:
+      reportVox(writeMagicaVoxel(file.stream(), grid, cellColors, kSolidCellColor, progress), report);
       break;
-    }
     case VoxelFormat::Vdb: {
       const VdbStats s = writeVdb(file.stream(), grid, progress);
       report.voxels = s.activeVoxels;
@@ -71,11 +94,23 @@ VoxelFileReport writeVoxelFile(const std::string& path, VoxelFormat format, cons
   return report;
 }
 
-VoxelFileReport writeBinvoxFile(const std::string& path, const Grid& plan, const VoxelRowSource& rows,
-                                const std::function<void(double)>& progress) {
+VoxelFileReport writeGridSetVoxelFile(const std::string& path, VoxelFormat format, const std::string& setPath,
+                                      const GridSetManifest& set, const GridFile& sceneFile, ColorMode color,
+                                      const std::function<void(double)>& progress) {
+  VOX_CHECK(format != VoxelFormat::Vdb);
+  const Grid& plan = sceneFile.grid;
   VoxelFileReport report;
   OutputFile file(path);
-  writeBinvoxRows(file.stream(), plan, rows, progress, report);
+  if (format == VoxelFormat::Binvox) {
+    const VoxelRowSource rows = [&](const std::function<void(const VoxelRow&)>& visit) {
+      forEachGridSetLayer(
+          setPath, set, sceneFile, [&](const Grid& layer) { forEachVoxelRow(layer, visit); }, LayerCells::KeysOnly);
+    };
+    writeBinvoxRows(file.stream(), plan, rows, progress, report);
+  } else {
+    const ColoredPieceSource pieces = setPieces(setPath, set, sceneFile, color);
+    reportVox(writeMagicaVoxelPieces(file.stream(), plan, pieces, kSolidCellColor, progress), report);
+  }
   file.commit();
   return report;
 }

@@ -44,4 +44,19 @@ std::vector<Rgb8> choosePalette(std::span<const Rgb8> colors, std::span<const ui
 MagicaVoxelStats writeMagicaVoxel(std::ostream& out, const Grid& grid, std::span<const Rgb8> cellColors,
                                   Rgb8 solidColor, const std::function<void(double)>& progress = {});
 
+// A grid's voxels in pieces, for writing a grid without holding it: each call hands `visit` every piece in key
+// order. A piece is a Grid with the whole grid's dims whose cellKeys (sorted) and solidRuns (checkSolidRuns) all
+// come after the previous piece's (a layer of bricks of a grid set: forEachGridSetLayer), with the colours of its
+// occupied cells as writeMagicaVoxel's cellColors (one per cell, or none for all-solidColor). Only the keys and runs
+// of a piece are read (its cellStart and primIds may be empty).
+using ColoredPieceVisitor = std::function<void(const Grid& piece, std::span<const Rgb8> cellColors)>;
+using ColoredPieceSource = std::function<void(const ColoredPieceVisitor& visit)>;
+
+// The same file as writeMagicaVoxel of the whole grid, from the plan of the grid (bounds and dims; its cells are not
+// read) and a source of its pieces, asked twice (to count the models' voxels and the colours' weights, then to
+// write; it must give the same pieces both times). Memory: one piece at a time plus one 256-thick slab of voxels.
+// Throws as writeMagicaVoxel, and InputError when the pieces' keys do not ascend from piece to piece.
+MagicaVoxelStats writeMagicaVoxelPieces(std::ostream& out, const Grid& plan, const ColoredPieceSource& pieces,
+                                        Rgb8 solidColor, const std::function<void(double)>& progress = {});
+
 }  // namespace vox

@@ -11,6 +11,7 @@
 #include "vox/core/grid.h"
 #include "vox/export/voxel_mesh.h"
 #include "vox/export/voxel_runs.h"
+#include "vox/io/grid_set.h"
 
 namespace vox {
 
@@ -36,10 +37,17 @@ struct VoxelFileReport {
 VoxelFileReport writeVoxelFile(const std::string& path, VoxelFormat format, const Grid& grid,
                                std::span<const Rgb8> cellColors, const std::function<void(double)>& progress = {});
 
-// binvox from the plan of a grid and a source of its voxel rows (writeBinvox's second form): what vox-export does for
-// a grid set, whose bricks are then read one layer at a time instead of assembled. The same file and report as
-// writeVoxelFile(Binvox) of the grid.
-VoxelFileReport writeBinvoxFile(const std::string& path, const Grid& plan, const VoxelRowSource& rows,
-                                const std::function<void(double)>& progress = {});
+// Writes the voxels of the grid set at `setPath` (its manifest `set` and scene file `sceneFile`, as
+// readGridSetManifest and readGridSetScene return them) to `path` as binvox or .vox without assembling the set: each
+// of the writer's passes reads the bricks one layer at a time (forEachGridSetLayer), keeping the layer's sorted keys
+// (binvox, and .vox without colours), keys and primitive counts (.vox by count, after one more pass for the largest
+// count) or keys and primitive lists (.vox by material). The same file and report as writeVoxelFile of the assembled
+// grid with occupiedCellColors(grid, scene, color) as its cell colours. Memory: one layer of bricks plus the writer's
+// own (binvox: run events and one plane; .vox: one 256-thick slab of voxels).
+// @note format is not Vdb (OpenVDB builds its tree of the whole grid).
+// Throws as writeVoxelFile, and as forEachGridSetLayer for a corrupt set.
+VoxelFileReport writeGridSetVoxelFile(const std::string& path, VoxelFormat format, const std::string& setPath,
+                                      const GridSetManifest& set, const GridFile& sceneFile, ColorMode color,
+                                      const std::function<void(double)>& progress = {});
 
 }  // namespace vox

@@ -43,7 +43,8 @@ void reportVox(const MagicaVoxelStats& s, VoxelFileReport& report) {
 }
 
 // A set's layers as .vox pieces, each with its cells' colours. By count, the ramp's top is the whole set's largest
-// count, found on a pass of its own: the colours of the first layer depend on cells of the last.
+// count, found on a pass of its own over the bricks (one at a time, unsorted): the colours of the first layer depend
+// on cells of the last.
 ColoredPieceSource setPieces(const std::string& setPath, const GridSetManifest& set, const GridFile& sceneFile,
                              ColorMode color) {
   const LayerCells cells = color == ColorMode::Count      ? LayerCells::KeysAndCounts
@@ -51,9 +52,9 @@ ColoredPieceSource setPieces(const std::string& setPath, const GridSetManifest& 
                                                           : LayerCells::KeysOnly;
   uint32_t maxCount = 0;
   if (color == ColorMode::Count)
-    forEachGridSetLayer(
-        setPath, set, sceneFile, [&](const Grid& layer) { maxCount = std::max(maxCount, largestCellCount(layer)); },
-        cells);
+    for (size_t i = 0; i < set.entries.size(); ++i)
+      maxCount =
+          std::max(maxCount, largestCellCount(readBrick(setPath, set, i, sceneFile.scene.boundedCount())));
   return [&setPath, &set, &sceneFile, color, cells, maxCount](const ColoredPieceVisitor& visit) {
     forEachGridSetLayer(
         setPath, set, sceneFile,

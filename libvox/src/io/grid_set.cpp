@@ -172,6 +172,18 @@ Grid readBrick(const std::string& setPath, const GridSetManifest& m, size_t entr
 
 namespace {
 
+// The counts are the manifest's word until each brick is read: the files of entries [first, end) must be on disk at
+// their listed sizes (which bound the counts, decodeGridSetManifest) before arrays are sized by them.
+void requireListedBricks(const std::string& setPath, const GridSetManifest& m, size_t first, size_t end) {
+  for (size_t i = first; i < end; ++i) {
+    const std::string brick = resolveInsideFolder(setPath, m.entries[i].file);
+    requireRegularFile(brick, "brick file");
+    std::error_code ec;
+    if (std::filesystem::file_size(brick, ec) != m.entries[i].fileSize || ec)
+      fail<InputError>(brick, ": not the brick ", setPath, " names (size differs; rewritten since?)");
+  }
+}
+
 // Appends a brick's cells to `whole`; the caller sorts when bricks interleave.
 void appendBrick(Grid& whole, const Grid& brick) {
   whole.cellKeys.insert(whole.cellKeys.end(), brick.cellKeys.begin(), brick.cellKeys.end());
@@ -197,8 +209,23 @@ void sortLayer(Grid& grid, LayerCells cells) {
     return;
   }
   if (cells == LayerCells::BrickOrder || std::is_sorted(grid.cellKeys.begin(), grid.cellKeys.end())) return;
-  const bool lists = cells == LayerCells::Sorted;
   const size_t n = grid.occupiedCount();
+  if (cells == LayerCells::KeysAndCounts) {
+    // (key, count) pairs sorted in place: a direct sort, 16 bytes a cell, where the indirect sort below takes 20 and
+    // twice the time (perf: most of a .vox export of a set at 2048^3).
+    struct KeyCount {
+      uint64_t key, count;
+    };
+    std::vector<KeyCount> pairs(n);
+    for (size_t c = 0; c < n; ++c) pairs[c] = {grid.cellKeys[c], grid.cellStart[c + 1] - grid.cellStart[c]};
+    std::sort(pairs.begin(), pairs.end(), [](const KeyCount& a, const KeyCount& b) { return a.key < b.key; });
+    for (size_t c = 0; c < n; ++c) {
+      grid.cellKeys[c] = pairs[c].key;
+      grid.cellStart[c + 1] = grid.cellStart[c] + pairs[c].count;
+    }
+    return;
+  }
+  const bool lists = cells == LayerCells::Sorted;
   std::vector<uint32_t> order(n);
   for (size_t c = 0; c < n; ++c) order[c] = uint32_t(c);
   std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return grid.cellKeys[a] < grid.cellKeys[b]; });
@@ -224,9 +251,26 @@ void sortLayer(Grid& grid, LayerCells cells) {
 void forEachGridSetLayer(const std::string& setPath, const GridSetManifest& m, const GridFile& sceneFile,
                          const std::function<void(const Grid& layer)>& visit, LayerCells cells) {
   size_t i = 0;
+  // One grid for every layer: its arrays keep their capacity from layer to layer instead of being allocated and
+  // faulted in again (page faults were a fifth of a .vox export's time).
+  Grid layer = emptyGridLike(sceneFile.grid);
   for (uint32_t bz = 0; bz < m.bricks[2]; ++bz) {
-    Grid layer = emptyGridLike(sceneFile.grid);
-    for (; i < m.entries.size() && m.entries[i].index[2] == bz; ++i) {
+    layer.cellKeys.clear();
+    layer.cellStart.assign(1, 0);
+    layer.primIds.clear();
+    layer.solidRuns.clear();
+    // Sized once from the manifest's counts, not grown by doubling as bricks are appended (up to twice the layer).
+    size_t end = i;
+    uint64_t occupied = 0, references = 0;
+    for (; end < m.entries.size() && m.entries[end].index[2] == bz; ++end) {
+      occupied += m.entries[end].occupied;
+      references += m.entries[end].references;
+    }
+    requireListedBricks(setPath, m, i, end);
+    layer.cellKeys.reserve(occupied);
+    if (cells != LayerCells::KeysOnly) layer.cellStart.reserve(occupied + 1);
+    if (cells == LayerCells::Sorted || cells == LayerCells::BrickOrder) layer.primIds.reserve(references);
+    for (; i < end; ++i) {
       Grid brick = readBrick(setPath, m, i, sceneFile.scene.boundedCount());
       if (cells == LayerCells::KeysOnly) brick.cellStart = {0};
       if (cells == LayerCells::KeysOnly || cells == LayerCells::KeysAndCounts)
@@ -248,15 +292,7 @@ GridFile readGridSet(const std::string& path) {
   }
   checkMemory(double(occupied) * 16 + double(references) * 4 + double(occupied) * 4, path, "the assembled grid");
   if (occupied > UINT32_MAX) fail<LimitError>(path, ": ", occupied, " cells are more than one process assembles");
-  // The counts are the manifest's word until each brick is read: its files must be on disk at their listed sizes
-  // (which bound the counts, decodeGridSetManifest) before the whole grid's arrays are sized by them.
-  for (const BrickEntry& e : m.entries) {
-    const std::string brick = resolveInsideFolder(path, e.file);
-    requireRegularFile(brick, "brick file");
-    std::error_code ec;
-    if (std::filesystem::file_size(brick, ec) != e.fileSize || ec)
-      fail<InputError>(brick, ": not the brick ", path, " names (size differs; rewritten since?)");
-  }
+  requireListedBricks(path, m, 0, m.entries.size());
   GridFile whole = readGridSetScene(path, m);
   Grid& g = whole.grid;
   g.cellKeys.reserve(occupied);

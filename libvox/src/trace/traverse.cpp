@@ -12,11 +12,12 @@ namespace {
 constexpr double kRel = kWalkRel;
 
 // Largest i in [0, n-1] with b[i] <= c (c below the grid gives 0, above gives n-1). The multiplication only guesses;
-// the comparisons with the table (the values of cellBoundary) decide.
+// the comparisons with the table (the values of cellBoundary) decide. The guess is clamped to [0, n - 1] before it is
+// truncated, which is then its floor: std::floor is a library call without SSE4.1 (4% of an incoherent ray).
 int64_t cellBelow(const CellBoundaries& cb, int a, double c) {
   const double* b = cb.b[a].data();
   const int64_t n = cb.dims[a];
-  double guess = std::floor((c - b[0]) * cb.cellsPerUnit[a]);
+  double guess = (c - b[0]) * cb.cellsPerUnit[a];
   if (!(guess >= 0)) guess = 0;
   if (guess > double(n - 1)) guess = double(n - 1);
   int64_t i = int64_t(guess);
@@ -283,6 +284,50 @@ inline bool directGroups(const Accel& accel, const filter::FilterRay* fr) {
   return fr && accel.sphereCount == 0 && !accel.floatCells.slots.empty();
 }
 
+// The walk over the grid's cells after the always-tested primitives: the nearest hit of the cells' primitives in
+// `best` (traceRay), or whether any is hit (occluded, AnyHit).
+template <bool AnyHit>
+inline bool walkCells(const Accel& accel, const Ray& ray, Hit& best, TraceStats& st) {
+  filter::FilterRay filterRay;
+  const filter::FilterRay* fr = filter::prepareFilterRay(accel.floatCells, ray, filterRay) ? &filterRay : nullptr;
+  const bool direct = directGroups(accel, fr);
+  GridWalker walker(accel, ray);
+  Mailbox<64> mailbox;
+  WalkCell cell;
+  while (walker.next(cell)) {
+    ++st.cells;
+    bool hit = false;
+    if (direct) {
+      hit = testGroups<AnyHit>(accel, accel.floatCell(cell.idx[0], cell.idx[1], cell.idx[2]), ray, *fr, mailbox, best, st);
+    } else {
+      const uint32_t c = accel.lookup(cell.idx[0], cell.idx[1], cell.idx[2]);
+      if (c < kSolidCell) hit = testCell<AnyHit>(accel, c, ray, fr, mailbox, best, st);
+    }
+    if (AnyHit) {
+      if (hit) return true;
+      continue;
+    }
+    // A hit may lie beyond this cell (a primitive spanning cells): it is kept, and accepted only once the walk
+    // has passed every cell that could hold a nearer one.
+    if (best.valid() && best.t + walker.hitSlack(best.t) < cell.tExit - cell.exitSlack) break;
+  }
+  return false;
+}
+
+// The walks compiled twice, for AVX2 (x86-64-v3's vector ISA, with SSE4.1's roundsd for floor and VEX-encoded float
+// filter) and for the baseline, and picked at load time like the packet kernel; `flatten` puts the walker, the
+// filter and the setup into each copy. The arithmetic is IEEE either way: no FMA is enabled (the "avx2" target does
+// not imply it, and -ffp-contract=off forbids contraction), so both copies visit the same cells and get the same t.
+// intersect.cpp's tests are called out of line, the same code for both.
+[[gnu::target_clones("avx2", "default"), gnu::flatten]] void walkNearest(const Accel& accel, const Ray& ray, Hit& best,
+                                                                         TraceStats& st) {
+  walkCells<false>(accel, ray, best, st);
+}
+[[gnu::target_clones("avx2", "default"), gnu::flatten]] bool walkAny(const Accel& accel, const Ray& ray, TraceStats& st) {
+  Hit any;
+  return walkCells<true>(accel, ray, any, st);
+}
+
 }  // namespace
 
 Hit traceRay(const Accel& accel, const Ray& ray, TraceStats* stats) {
@@ -294,24 +339,7 @@ Hit traceRay(const Accel& accel, const Ray& ray, TraceStats* stats) {
     for (uint32_t id = 0; id < n; ++id) consider(accel, id, ray, best, st);
   } else {
     for (uint32_t id : accel.alwaysTested) consider(accel, id, ray, best, st);
-    filter::FilterRay filterRay;
-    const filter::FilterRay* fr = filter::prepareFilterRay(accel.floatCells, ray, filterRay) ? &filterRay : nullptr;
-    const bool direct = directGroups(accel, fr);
-    GridWalker walker(accel, ray);
-    Mailbox<64> mailbox;
-    WalkCell cell;
-    while (walker.next(cell)) {
-      ++st.cells;
-      if (direct) {
-        testGroups<false>(accel, accel.floatCell(cell.idx[0], cell.idx[1], cell.idx[2]), ray, *fr, mailbox, best, st);
-      } else {
-        const uint32_t c = accel.lookup(cell.idx[0], cell.idx[1], cell.idx[2]);
-        if (c < kSolidCell) testCell<false>(accel, c, ray, fr, mailbox, best, st);
-      }
-      // A hit may lie beyond this cell (a primitive spanning cells): it is kept, and accepted only once the walk
-      // has passed every cell that could hold a nearer one.
-      if (best.valid() && best.t + walker.hitSlack(best.t) < cell.tExit - cell.exitSlack) break;
-    }
+    walkNearest(accel, ray, best, st);
   }
   if (stats) *stats += st;
   return best;
@@ -333,23 +361,7 @@ bool occluded(const Accel& accel, const Ray& ray, TraceStats* stats) {
       ++st.tests;
       hit = intersectPrimitive(accel, accel.alwaysTested[i], ray, t);
     }
-    filter::FilterRay filterRay;
-    const filter::FilterRay* fr =
-        hit ? nullptr : filter::prepareFilterRay(accel.floatCells, ray, filterRay) ? &filterRay : nullptr;
-    const bool direct = directGroups(accel, fr);
-    GridWalker walker(accel, ray);
-    Mailbox<64> mailbox;
-    WalkCell cell;
-    Hit any;
-    while (!hit && walker.next(cell)) {
-      ++st.cells;
-      if (direct) {
-        hit = testGroups<true>(accel, accel.floatCell(cell.idx[0], cell.idx[1], cell.idx[2]), ray, *fr, mailbox, any, st);
-      } else {
-        const uint32_t c = accel.lookup(cell.idx[0], cell.idx[1], cell.idx[2]);
-        if (c < kSolidCell) hit = testCell<true>(accel, c, ray, fr, mailbox, any, st);
-      }
-    }
+    if (!hit) hit = walkAny(accel, ray, st);
   }
   if (stats) *stats += st;
   return hit;

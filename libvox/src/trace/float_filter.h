@@ -21,6 +21,9 @@
 // origin beyond 2^40 of the scaled grid, does not use the filter.
 #pragma once
 
+#include <algorithm>
+#include <bit>
+#include <cmath>
 #include <cstdint>
 
 #include "vox/trace/accel.h"
@@ -41,9 +44,45 @@ struct FilterRay {
   Float4 eu, ew;  // bounds on |U - U*| (and V) and |W - W*|, see above
 };
 
+inline constexpr double kU = 0x1.0p-24;        // unit roundoff of float
+inline constexpr double kUp = 1 + 0x1.0p-40;   // rounds a double bound up past the double rounding that computed it
+inline constexpr double kToFloatUp = 1 + 0x1.0p-20;  // keeps a bound an upper bound through its rounding to float
+inline constexpr double kMaxOrigin = 0x1.0p40;
+
 // Prepares `ray` for the filter; false when the accel has no float cells or the ray is outside what the bound
-// covers (then the walk tests every triangle in double).
-bool prepareFilterRay(const FloatCells& cells, const Ray& ray, FilterRay& out);
+// covers (then the walk tests every triangle in double). Inline, so that each compiled copy of the walk
+// (traverse.cpp) has its own.
+inline bool prepareFilterRay(const FloatCells& fc, const Ray& ray, FilterRay& out) {
+  if (!fc.enabled) return false;
+  const Vec3& d = ray.direction;
+  const double dMax = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
+  if (!(dMax > 0) || !std::isfinite(dMax)) return false;
+  // Direction scaled by a power of two to [1, 2) in its largest component: U, V, D, W all scale alike. The power is
+  // read from the exponent bits (frexp and ldexp are library calls, per ray); subnormal or huge dMax skip the filter.
+  const int biased = int((std::bit_cast<uint64_t>(dMax) >> 52) & 0x7ff);
+  if (biased == 0 || biased >= 2046) return false;
+  const double dScale = std::bit_cast<double>(uint64_t(2046 - biased) << 52);  // 2^(1023 - biased)
+  double S[3], ad[3];
+  for (int a = 0; a < 3; ++a) {
+    const double o = (ray.origin[a] - fc.center[a]) * fc.scale;
+    const double dd = d[a] * dScale;
+    if (!(std::fabs(o) <= kMaxOrigin)) return false;
+    out.o[a] = Float4{} + float(o);
+    out.d[a] = Float4{} + float(dd);
+    S[a] = std::fabs(o) * kUp + fc.vertexMax[a];
+    ad[a] = std::fabs(dd);
+  }
+  const double C[3] = {S[1] * ad[2] + S[2] * ad[1], S[2] * ad[0] + S[0] * ad[2], S[0] * ad[1] + S[1] * ad[0]};
+  const double um = fc.edgeMax[0] * C[0] + fc.edgeMax[1] * C[1] + fc.edgeMax[2] * C[2];
+  const double dm = ad[0] * fc.normalMax[0] + ad[1] * fc.normalMax[1] + ad[2] * fc.normalMax[2];
+  const double eta = 0x1.0p-120 * (1 + S[0] + S[1] + S[2] + C[0] + C[1] + C[2] + um + dm);
+  const double eu = 12 * kU * um + eta;
+  const double ed = 7 * kU * dm + eta;
+  const double ew = ed + 2 * eu + 3 * kU * dm + 4 * kU * um;
+  out.eu = Float4{} + float(eu * kToFloatUp);
+  out.ew = Float4{} + float(ew * kToFloatUp);
+  return true;
+}
 
 // Bit l set for every lane l < count of `g` that the double test might hit (the others it certainly misses).
 [[gnu::always_inline]] inline uint32_t maybeHits(const TriangleGroup4& g, const FilterRay& r, uint32_t count) {

@@ -315,9 +315,10 @@ inline bool walkCells(const Accel& accel, const Ray& ray, Hit& best, TraceStats&
 }
 
 // The walks compiled twice, for AVX2 (VEX-encoded float filter and setup, SSE4.1) and for the baseline, and picked at
-// load time like the packet kernel; `flatten` puts the walker, the filter and the setup into each copy. The arithmetic is IEEE either way: no FMA is enabled (the "avx2" target does
-// not imply it, and -ffp-contract=off forbids contraction), so both copies visit the same cells and get the same t.
-// intersect.cpp's tests are called out of line, the same code for both.
+// load time like the packet kernel; `flatten` puts the walker, the filter and the setup into each copy. The
+// arithmetic is IEEE either way: no FMA is enabled (the "avx2" target does not imply it, and -ffp-contract=off forbids
+// contraction), so both copies visit the same cells and get the same t. intersect.cpp's tests are called out of line,
+// the same code for both.
 [[gnu::target_clones("avx2", "default"), gnu::flatten]] void walkNearest(const Accel& accel, const Ray& ray, Hit& best,
                                                                          TraceStats& st) {
   walkCells<false>(accel, ray, best, st);

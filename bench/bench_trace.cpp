@@ -128,7 +128,8 @@ TiledRays tileRays(const std::vector<vox::Ray>& rays, uint32_t size) {
 }
 
 // One tile through vox::tracePacket; hits in tile order.
-void tracePackets(const vox::Accel& accel, const TiledRays& tiled, size_t tile, vox::Hit* hits, vox::TraceStats* stats) {
+void tracePackets(const vox::Accel& accel, const TiledRays& tiled, size_t tile, vox::Hit* hits,
+                  vox::TraceStats* stats) {
   const uint32_t begin = tiled.tileStart[tile], count = tiled.tileStart[tile + 1] - begin;
   vox::tracePacket(accel, {tiled.rays.data() + begin, count}, {hits + begin, count}, stats);
 }
@@ -143,14 +144,16 @@ std::array<uint32_t, 3> dimsForFactor(const vox::Box& b, size_t triangles, doubl
 }
 
 // Primary rays at each cells-per-triangle factor (the table of README's Tracing paragraph).
-void benchPrimary(const std::string& path, unsigned threads, uint32_t size, int reps, const std::vector<double>& factors) {
+void benchPrimary(const std::string& path, unsigned threads, uint32_t size, int reps,
+                  const std::vector<double>& factors) {
   const vox::Scene scene = vox::loadScene(path);
   const vox::Box bounds = *vox::sceneBounds(scene);
   const vox::Camera cam = vox::defaultCamera(bounds);
   const uint64_t rayCount = uint64_t(size) * size;
   std::vector<vox::Ray> rays(rayCount);
   for (uint32_t y = 0; y < size; ++y)
-    for (uint32_t x = 0; x < size; ++x) rays[uint64_t(y) * size + x] = vox::primaryRay(cam, size, size, x + 0.5, y + 0.5);
+    for (uint32_t x = 0; x < size; ++x)
+      rays[uint64_t(y) * size + x] = vox::primaryRay(cam, size, size, x + 0.5, y + 0.5);
 
   // Embree: the same triangles as floats.
   const EmbreeScene embree(scene, threads);
@@ -161,44 +164,50 @@ void benchPrimary(const std::string& path, unsigned threads, uint32_t size, int 
   const size_t tileCount = tiled.tileStart.size() - 1;
   std::vector<Method> methods;
   std::vector<unsigned> embreeHit(rayCount);
-  methods.push_back({"embree rtcIntersect1", [&] {
-    tbb::parallel_for(tbb::blocked_range<uint64_t>(0, rayCount, 1024), [&](const tbb::blocked_range<uint64_t>& r) {
-      RTCIntersectContext ctx;
-      rtcInitIntersectContext(&ctx);
-      for (uint64_t i = r.begin(); i < r.end(); ++i) {
-        const vox::Ray& ray = tiled.rays[i];
-        RTCRayHit rh{};
-        rh.ray.org_x = float(ray.origin.x), rh.ray.org_y = float(ray.origin.y), rh.ray.org_z = float(ray.origin.z);
-        rh.ray.dir_x = float(ray.direction.x), rh.ray.dir_y = float(ray.direction.y), rh.ray.dir_z = float(ray.direction.z);
-        rh.ray.tnear = 0, rh.ray.tfar = INFINITY, rh.ray.mask = unsigned(-1);
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(es, &ctx, &rh);
-        embreeHit[tiled.pixel[i]] = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? vox::kNoPrim : rh.hit.primID;
-      }
-    });
-  }});
+  methods.push_back(
+      {"embree rtcIntersect1", [&] {
+         tbb::parallel_for(tbb::blocked_range<uint64_t>(0, rayCount, 1024), [&](const tbb::blocked_range<uint64_t>& r) {
+           RTCIntersectContext ctx;
+           rtcInitIntersectContext(&ctx);
+           for (uint64_t i = r.begin(); i < r.end(); ++i) {
+             const vox::Ray& ray = tiled.rays[i];
+             RTCRayHit rh{};
+             rh.ray.org_x = float(ray.origin.x), rh.ray.org_y = float(ray.origin.y), rh.ray.org_z = float(ray.origin.z);
+             rh.ray.dir_x = float(ray.direction.x), rh.ray.dir_y = float(ray.direction.y),
+             rh.ray.dir_z = float(ray.direction.z);
+             rh.ray.tnear = 0, rh.ray.tfar = INFINITY, rh.ray.mask = unsigned(-1);
+             rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+             rtcIntersect1(es, &ctx, &rh);
+             embreeHit[tiled.pixel[i]] = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? vox::kNoPrim : rh.hit.primID;
+           }
+         });
+       }});
   // Packets of 8: 4x2 pixel blocks, coherent context.
   methods.push_back({"embree rtcIntersect8 coherent", [&] {
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, size / 2), [&](const tbb::blocked_range<uint32_t>& rows) {
-      RTCIntersectContext ctx;
-      rtcInitIntersectContext(&ctx);
-      ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-      alignas(32) RTCRayHit8 rh;
-      alignas(32) int valid[8];
-      for (uint32_t by = rows.begin(); by < rows.end(); ++by)
-        for (uint32_t bx = 0; bx + 4 <= size; bx += 4) {
-          for (int k = 0; k < 8; ++k) {
-            const vox::Ray& ray = rays[uint64_t(2 * by + k / 4) * size + bx + k % 4];
-            valid[k] = -1;
-            rh.ray.org_x[k] = float(ray.origin.x), rh.ray.org_y[k] = float(ray.origin.y), rh.ray.org_z[k] = float(ray.origin.z);
-            rh.ray.dir_x[k] = float(ray.direction.x), rh.ray.dir_y[k] = float(ray.direction.y), rh.ray.dir_z[k] = float(ray.direction.z);
-            rh.ray.tnear[k] = 0, rh.ray.tfar[k] = INFINITY, rh.ray.mask[k] = unsigned(-1), rh.ray.time[k] = 0, rh.ray.flags[k] = 0;
-            rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-          }
-          rtcIntersect8(valid, es, &ctx, &rh);
-        }
-    });
-  }});
+                       tbb::parallel_for(
+                           tbb::blocked_range<uint32_t>(0, size / 2), [&](const tbb::blocked_range<uint32_t>& rows) {
+                             RTCIntersectContext ctx;
+                             rtcInitIntersectContext(&ctx);
+                             ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+                             alignas(32) RTCRayHit8 rh;
+                             alignas(32) int valid[8];
+                             for (uint32_t by = rows.begin(); by < rows.end(); ++by)
+                               for (uint32_t bx = 0; bx + 4 <= size; bx += 4) {
+                                 for (int k = 0; k < 8; ++k) {
+                                   const vox::Ray& ray = rays[uint64_t(2 * by + k / 4) * size + bx + k % 4];
+                                   valid[k] = -1;
+                                   rh.ray.org_x[k] = float(ray.origin.x), rh.ray.org_y[k] = float(ray.origin.y),
+                                   rh.ray.org_z[k] = float(ray.origin.z);
+                                   rh.ray.dir_x[k] = float(ray.direction.x), rh.ray.dir_y[k] = float(ray.direction.y),
+                                   rh.ray.dir_z[k] = float(ray.direction.z);
+                                   rh.ray.tnear[k] = 0, rh.ray.tfar[k] = INFINITY, rh.ray.mask[k] = unsigned(-1),
+                                   rh.ray.time[k] = 0, rh.ray.flags[k] = 0;
+                                   rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+                                 }
+                                 rtcIntersect8(valid, es, &ctx, &rh);
+                               }
+                           });
+                     }});
 
   struct Variant {
     std::unique_ptr<vox::Grid> grid;
@@ -220,15 +229,19 @@ void benchPrimary(const std::string& path, unsigned threads, uint32_t size, int 
     v.single.resize(rayCount);
     v.packet.resize(rayCount);
     methods.push_back({"grid traceRay", [&v, &tiled, rayCount] {
-      tbb::parallel_for(tbb::blocked_range<uint64_t>(0, rayCount, 1024), [&](const tbb::blocked_range<uint64_t>& r) {
-        for (uint64_t i = r.begin(); i < r.end(); ++i) v.single[tiled.pixel[i]] = vox::traceRay(*v.accel, tiled.rays[i]).prim;
-      });
-    }});
+                         tbb::parallel_for(tbb::blocked_range<uint64_t>(0, rayCount, 1024),
+                                           [&](const tbb::blocked_range<uint64_t>& r) {
+                                             for (uint64_t i = r.begin(); i < r.end(); ++i)
+                                               v.single[tiled.pixel[i]] = vox::traceRay(*v.accel, tiled.rays[i]).prim;
+                                           });
+                       }});
     methods.push_back({"grid tracePacket", [&v, &tiled, tileCount] {
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, tileCount, 16), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t tile = r.begin(); tile < r.end(); ++tile) tracePackets(*v.accel, tiled, tile, v.packet.data(), nullptr);
-      });
-    }});
+                         tbb::parallel_for(tbb::blocked_range<size_t>(0, tileCount, 16),
+                                           [&](const tbb::blocked_range<size_t>& r) {
+                                             for (size_t tile = r.begin(); tile < r.end(); ++tile)
+                                               tracePackets(*v.accel, tiled, tile, v.packet.data(), nullptr);
+                                           });
+                       }});
   }
   timeInTurns(methods, reps);
 
@@ -252,14 +265,16 @@ void benchPrimary(const std::string& path, unsigned threads, uint32_t size, int 
     }
     std::printf("  grid %4ux%4ux%4u (%.1f cells/tri, voxelize %.2f s), %.1f%% of rays hit\n", v.grid->dims[0],
                 v.grid->dims[1], v.grid->dims[2], v.factor, v.voxelizeSeconds, 100.0 * hits / rayCount);
-    std::printf("    traceRay:    %8.2f Mrays/s  ratio vs rtcIntersect1 %.3f, vs rtcIntersect8 %.3f  cells/ray %.2f "
-                "tests/ray %.2f  same prim as embree %.3f%%\n",
-                rayCount / g / 1e6, e1 / g, e8 / g, double(st.cells) / st.rays, double(st.tests) / st.rays,
-                100.0 * same / rayCount);
-    std::printf("    tracePacket: %8.2f Mrays/s  ratio vs rtcIntersect1 %.3f, vs rtcIntersect8 %.3f  cells/ray %.2f "
-                "tests/ray %.2f  same prim as traceRay %.3f%%\n",
-                rayCount / gp / 1e6, e1 / gp, e8 / gp, double(pst.cells) / pst.rays, double(pst.tests) / pst.rays,
-                100.0 * packetSame / rayCount);
+    std::printf(
+        "    traceRay:    %8.2f Mrays/s  ratio vs rtcIntersect1 %.3f, vs rtcIntersect8 %.3f  cells/ray %.2f "
+        "tests/ray %.2f  same prim as embree %.3f%%\n",
+        rayCount / g / 1e6, e1 / g, e8 / g, double(st.cells) / st.rays, double(st.tests) / st.rays,
+        100.0 * same / rayCount);
+    std::printf(
+        "    tracePacket: %8.2f Mrays/s  ratio vs rtcIntersect1 %.3f, vs rtcIntersect8 %.3f  cells/ray %.2f "
+        "tests/ray %.2f  same prim as traceRay %.3f%%\n",
+        rayCount / gp / 1e6, e1 / gp, e8 / gp, double(pst.cells) / pst.rays, double(pst.tests) / pst.rays,
+        100.0 * packetSame / rayCount);
     std::fflush(stdout);
   }
 }
@@ -300,8 +315,8 @@ vox::Vec3 hemisphereDirection(const vox::Vec3& n, SplitMix& rng) {
 // surface by 1e-5 of the diagonal along the normal facing the incoming ray, far above float rounding at these
 // scales, so that neither tracer hits the surface it starts from.
 std::vector<RaySet> secondaryRays(const vox::Accel& accel, const std::vector<vox::Ray>& primary, const vox::Box& b) {
-  std::vector<RaySet> sets = {{"reflection", false, {}}, {"hemisphere", false, {}}, {"ao", true, {}},
-                              {"shadow", true, {}}};
+  std::vector<RaySet> sets = {
+      {"reflection", false, {}}, {"hemisphere", false, {}}, {"ao", true, {}}, {"shadow", true, {}}};
   const vox::Vec3 extent = b.hi - b.lo, centre = (b.lo + b.hi) * 0.5;
   const double diag = vox::length(extent), lift = 1e-5 * diag;
   const vox::Vec3 light = centre + vox::Vec3{0.6, 1.4, 0.9} * diag;
@@ -336,7 +351,8 @@ void embreeTrace(RTCScene es, const RaySet& set, std::vector<EmbreeResult>& out)
       const vox::Ray& ray = set.rays[i];
       RTCRayHit rh{};
       rh.ray.org_x = float(ray.origin.x), rh.ray.org_y = float(ray.origin.y), rh.ray.org_z = float(ray.origin.z);
-      rh.ray.dir_x = float(ray.direction.x), rh.ray.dir_y = float(ray.direction.y), rh.ray.dir_z = float(ray.direction.z);
+      rh.ray.dir_x = float(ray.direction.x), rh.ray.dir_y = float(ray.direction.y),
+      rh.ray.dir_z = float(ray.direction.z);
       rh.ray.tnear = float(ray.tMin), rh.ray.tfar = float(ray.tMax), rh.ray.mask = unsigned(-1);
       rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
       if (set.occlusion) {
@@ -344,8 +360,10 @@ void embreeTrace(RTCScene es, const RaySet& set, std::vector<EmbreeResult>& out)
         out[i] = {rh.ray.tfar < 0 ? 0.0f : INFINITY, vox::kNoPrim};
       } else {
         rtcIntersect1(es, &ctx, &rh);
-        if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) out[i] = {rh.ray.tfar, rh.hit.primID};
-        else out[i] = {};
+        if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)
+          out[i] = {rh.ray.tfar, rh.hit.primID};
+        else
+          out[i] = {};
       }
     }
   });
@@ -355,8 +373,10 @@ void embreeTrace(RTCScene es, const RaySet& set, std::vector<EmbreeResult>& out)
 void voxTrace(const vox::Accel& accel, const RaySet& set, std::vector<vox::Hit>& out) {
   tbb::parallel_for(tbb::blocked_range<size_t>(0, set.rays.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t i = r.begin(); i < r.end(); ++i) {
-      if (set.occlusion) out[i] = vox::occluded(accel, set.rays[i]) ? vox::Hit{0, 0} : vox::Hit{};
-      else out[i] = vox::traceRay(accel, set.rays[i]);
+      if (set.occlusion)
+        out[i] = vox::occluded(accel, set.rays[i]) ? vox::Hit{0, 0} : vox::Hit{};
+      else
+        out[i] = vox::traceRay(accel, set.rays[i]);
     }
   });
 }
@@ -427,8 +447,8 @@ void benchIncoherent(const std::string& path, unsigned threads, uint32_t size, i
   const double diag = vox::length(bounds.hi - bounds.lo);
 
   const char* name = std::strrchr(path.c_str(), '/') ? std::strrchr(path.c_str(), '/') + 1 : path.c_str();
-  std::printf("\n%s: %zu triangles, default grid %ux%ux%u, %zu secondary rays per set\n", name,
-              scene.triangles.size(), grid.dims[0], grid.dims[1], grid.dims[2], sets[0].rays.size());
+  std::printf("\n%s: %zu triangles, default grid %ux%ux%u, %zu secondary rays per set\n", name, scene.triangles.size(),
+              grid.dims[0], grid.dims[1], grid.dims[2], sets[0].rays.size());
   std::printf("  %-11s %10s %10s %12s %12s %8s %8s %9s %9s %9s %s\n", "set", "query", "embree", "ours", "ours/embree",
               "(best)", "(cpu)", "same", "close t", "mismatch", "brute force (diff/checked), per ray");
   for (const RaySet& set : sets) {
@@ -454,22 +474,23 @@ void benchIncoherent(const std::string& path, unsigned threads, uint32_t size, i
       byIdDiff += ours[i].prim != byIdHits[i].prim || std::memcmp(&ours[i].t, &byIdHits[i].t, sizeof(double)) != 0;
     const Agreement a = compareWithEmbree(set, ours, e, diag);
     uint64_t checked = 0;
-    const uint64_t bruteDiff = bruteForceDifferences(brute, set, ours, std::max<size_t>(1, set.rays.size() / 500), checked);
+    const uint64_t bruteDiff =
+        bruteForceDifferences(brute, set, ours, std::max<size_t>(1, set.rays.size() / 500), checked);
     const double n = double(set.rays.size());
     vox::TraceStats st;
     for (size_t i = 0; i < set.rays.size(); i += 97)
       set.occlusion ? void(vox::occluded(accel, set.rays[i], &st)) : void(vox::traceRay(accel, set.rays[i], &st));
-    std::printf("  %-11s %10s %8.2f M %10.2f M %12.3f %8.3f %8.3f %8.3f%% %8.3f%% %9llu %llu/%llu  %.1f cells, %.1f tests (%.2f in double)"
-                "  double only: %.3f (cpu %.3f), %llu differ\n",
-                set.name.c_str(),
-                set.occlusion ? "occluded" : "closest", n / methods[0].median() / 1e6, n / methods[1].median() / 1e6,
-                methods[0].median() / methods[1].median(), methods[0].best / methods[1].best,
-                methods[0].median(true) / methods[1].median(true), 100.0 * a.same / n,
-                100.0 * a.closeT / n, (unsigned long long)a.mismatch, (unsigned long long)bruteDiff,
-                (unsigned long long)checked, double(st.cells) / st.rays, double(st.tests + st.filtered) / st.rays,
-                double(st.tests) / st.rays,
-                methods[2].median() / methods[1].median(), methods[2].median(true) / methods[1].median(true),
-                (unsigned long long)byIdDiff);
+    std::printf(
+        "  %-11s %10s %8.2f M %10.2f M %12.3f %8.3f %8.3f %8.3f%% %8.3f%% %9llu %llu/%llu  %.1f cells, %.1f tests "
+        "(%.2f in double)"
+        "  double only: %.3f (cpu %.3f), %llu differ\n",
+        set.name.c_str(), set.occlusion ? "occluded" : "closest", n / methods[0].median() / 1e6,
+        n / methods[1].median() / 1e6, methods[0].median() / methods[1].median(), methods[0].best / methods[1].best,
+        methods[0].median(true) / methods[1].median(true), 100.0 * a.same / n, 100.0 * a.closeT / n,
+        (unsigned long long)a.mismatch, (unsigned long long)bruteDiff, (unsigned long long)checked,
+        double(st.cells) / st.rays, double(st.tests + st.filtered) / st.rays, double(st.tests) / st.rays,
+        methods[2].median() / methods[1].median(), methods[2].median(true) / methods[1].median(true),
+        (unsigned long long)byIdDiff);
     std::fflush(stdout);
   }
 }
@@ -485,30 +506,43 @@ int main(int argc, char** argv) {
   bool incoherent = false, oursOnly = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--threads" && i + 1 < argc) threads = unsigned(std::atoi(argv[++i]));
-    else if (a == "--size" && i + 1 < argc) size = uint32_t(std::atoi(argv[++i]));
-    else if (a == "--reps" && i + 1 < argc) reps = std::max(1, std::atoi(argv[++i]));
-    else if (a == "--factor" && i + 1 < argc) factors.push_back(std::atof(argv[++i]));
-    else if (a == "--incoherent") incoherent = true;
-    else if (a == "--ours-only") oursOnly = true;
-    else scenes.push_back(a);
+    if (a == "--threads" && i + 1 < argc)
+      threads = unsigned(std::atoi(argv[++i]));
+    else if (a == "--size" && i + 1 < argc)
+      size = uint32_t(std::atoi(argv[++i]));
+    else if (a == "--reps" && i + 1 < argc)
+      reps = std::max(1, std::atoi(argv[++i]));
+    else if (a == "--factor" && i + 1 < argc)
+      factors.push_back(std::atof(argv[++i]));
+    else if (a == "--incoherent")
+      incoherent = true;
+    else if (a == "--ours-only")
+      oursOnly = true;
+    else
+      scenes.push_back(a);
   }
   if (factors.empty()) factors = {0.5, 1, 2, 3};
   // The incoherent sets read SheenCloth from its glTF sample (issue 12), the primary table from its OBJ copy.
-  const std::string cloth = incoherent ? "/gltf/SheenCloth/glTF/SheenCloth.gltf" : "/meshes/derived/sheencloth_115k.obj";
+  const std::string cloth =
+      incoherent ? "/gltf/SheenCloth/glTF/SheenCloth.gltf" : "/meshes/derived/sheencloth_115k.obj";
   if (scenes.empty())
-    scenes = {std::string(VOX_SEED_DIR) + "/6837/scenes/bunny_40k.obj", std::string(VOX_SEED_DIR) + "/meshes/bun_zipper.ply",
-              std::string(VOX_SEED_DIR) + cloth};
+    scenes = {std::string(VOX_SEED_DIR) + "/6837/scenes/bunny_40k.obj",
+              std::string(VOX_SEED_DIR) + "/meshes/bun_zipper.ply", std::string(VOX_SEED_DIR) + cloth};
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
   if (incoherent)
-    std::printf("threads: %u, secondary rays from the hits of %ux%u primary rays, Mrays/s of the median of %d rounds "
-                "taken in turns (best: ratio of best times; cpu: of median process CPU times)\n", threads, size, size, reps);
+    std::printf(
+        "threads: %u, secondary rays from the hits of %ux%u primary rays, Mrays/s of the median of %d rounds "
+        "taken in turns (best: ratio of best times; cpu: of median process CPU times)\n",
+        threads, size, size, reps);
   else
-    std::printf("threads: %u, image: %ux%u primary rays, best of %d rounds taken in turns\n", threads, size, size, reps);
+    std::printf("threads: %u, image: %ux%u primary rays, best of %d rounds taken in turns\n", threads, size, size,
+                reps);
 
   for (const std::string& path : scenes) {
-    if (incoherent) benchIncoherent(path, threads, size, reps, oursOnly);
-    else benchPrimary(path, threads, size, reps, factors);
+    if (incoherent)
+      benchIncoherent(path, threads, size, reps, oursOnly);
+    else
+      benchPrimary(path, threads, size, reps, factors);
   }
   return 0;
 }

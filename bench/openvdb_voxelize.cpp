@@ -37,17 +37,20 @@ int main(int argc, char** argv) {
   }
   const auto xform = openvdb::math::Transform::createLinearTransform(voxel);
   const auto t0 = std::chrono::steady_clock::now();
-  const auto grid = openvdb::tools::meshToUnsignedDistanceField<openvdb::FloatGrid>(*xform, points, triangles, quads, 1.0f);
+  const auto grid =
+      openvdb::tools::meshToUnsignedDistanceField<openvdb::FloatGrid>(*xform, points, triangles, quads, 1.0f);
   const auto t1 = std::chrono::steady_clock::now();
   // Voxels within one voxel of the surface: the band OpenVDB marks.
   uint64_t marked = 0;
   for (auto it = grid->cbeginValueOn(); it; ++it) marked += it.getValue() <= float(voxel) ? 1 : 0;
   rusage usage{};
   ::getrusage(RUSAGE_SELF, &usage);
-  std::printf("voxel_size: %.9g\nactive_voxels: %llu\nmarked_voxels: %llu\nvoxelize_seconds: %.6f\ntotal_seconds: %.6f\npeak_memory_mb: %.1f\n",
-              voxel, (unsigned long long)grid->activeVoxelCount(), (unsigned long long)marked,
-              std::chrono::duration<double>(t1 - t0).count(),
-              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
-              double(usage.ru_maxrss) / 1024.0);
+  std::printf(
+      "voxel_size: %.9g\nactive_voxels: %llu\nmarked_voxels: %llu\nvoxelize_seconds: %.6f\ntotal_seconds: "
+      "%.6f\npeak_memory_mb: %.1f\n",
+      voxel, (unsigned long long)grid->activeVoxelCount(), (unsigned long long)marked,
+      std::chrono::duration<double>(t1 - t0).count(),
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+      double(usage.ru_maxrss) / 1024.0);
   return 0;
 }

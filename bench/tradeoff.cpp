@@ -41,7 +41,8 @@ int main(int argc, char** argv) {
     out << vox::bench::csvHeader() << "\n";
     for (const auto& scene : vox::bench::tradeoffScenes(VOX_SEED_DIR, small)) {
       std::fprintf(stderr, "%s...\n", scene.name.c_str());
-      for (const auto& row : vox::bench::measureTradeoff(scene, options)) out << vox::bench::csvLine(row) << "\n" << std::flush;
+      for (const auto& row : vox::bench::measureTradeoff(scene, options))
+        out << vox::bench::csvLine(row) << "\n" << std::flush;
     }
     if (!out) throw vox::OutputError(std::string(argv[1]) + ": cannot write");
   } catch (const std::exception& e) {

@@ -82,7 +82,8 @@ inline Camera cameraFor(const Scene& scene) {
 
 struct TradeoffOptions {
   std::vector<uint32_t> resolutions;  // cells on the longest axis; 0 stands for the default heuristic
-  std::vector<OverlapMethod> methods{OverlapMethod::Exact, OverlapMethod::Sat, OverlapMethod::BBox, OverlapMethod::Center};
+  std::vector<OverlapMethod> methods{OverlapMethod::Exact, OverlapMethod::Sat, OverlapMethod::BBox,
+                                     OverlapMethod::Center};
   uint32_t imageSize = 256;
   bool trace = true;
 };
@@ -164,13 +165,14 @@ inline std::string csvHeader() {
 
 inline std::string csvLine(const TradeoffRow& r) {
   char buf[512];
-  std::snprintf(buf, sizeof buf, "%s,%zu,%u,%u,%u,%u,%s,%.6f,%llu,%.0f,%llu,%llu,%llu,%llu,%llu,%llu,%.6f,%.6f,%.3f,%.3f,%llu,%llu",
+  std::snprintf(buf, sizeof buf,
+                "%s,%zu,%u,%u,%u,%u,%s,%.6f,%llu,%.0f,%llu,%llu,%llu,%llu,%llu,%llu,%.6f,%.6f,%.3f,%.3f,%llu,%llu",
                 r.scene.c_str(), r.primitives, r.resolution, r.dims[0], r.dims[1], r.dims[2], r.method.c_str(),
-                r.voxelizeSeconds, (unsigned long long)r.tests, r.voxelizeSeconds > 0 ? double(r.tests) / r.voxelizeSeconds : 0.0,
-                (unsigned long long)r.occupied, (unsigned long long)r.references, (unsigned long long)r.cellsAdded,
-                (unsigned long long)r.cellsMissed, (unsigned long long)r.refsAdded, (unsigned long long)r.refsMissed,
-                r.primarySeconds, r.shadeSeconds, r.cellsPerRay, r.testsPerRay, (unsigned long long)r.pixelsDiffering,
-                (unsigned long long)r.pixels);
+                r.voxelizeSeconds, (unsigned long long)r.tests,
+                r.voxelizeSeconds > 0 ? double(r.tests) / r.voxelizeSeconds : 0.0, (unsigned long long)r.occupied,
+                (unsigned long long)r.references, (unsigned long long)r.cellsAdded, (unsigned long long)r.cellsMissed,
+                (unsigned long long)r.refsAdded, (unsigned long long)r.refsMissed, r.primarySeconds, r.shadeSeconds,
+                r.cellsPerRay, r.testsPerRay, (unsigned long long)r.pixelsDiffering, (unsigned long long)r.pixels);
   return buf;
 }
 
@@ -202,7 +204,8 @@ inline std::vector<TradeoffScene> tradeoffScenes(const std::string& seedDir, boo
     };
     for (int i = 0; i < (small ? 300 : 2000); ++i) {
       const Vec3 a{rnd(), rnd(), rnd()};
-      mixed.triangles.push_back({{a, a + Vec3{0.01 * rnd(), 0.01 * rnd(), 0}, a + Vec3{0, 0.01 * rnd(), 0.01 * rnd()}}});
+      mixed.triangles.push_back(
+          {{a, a + Vec3{0.01 * rnd(), 0.01 * rnd(), 0}, a + Vec3{0, 0.01 * rnd(), 0.01 * rnd()}}});
     }
     mixed.triangles.push_back({{Vec3{0, 0, 0}, Vec3{1, 0, 1}, Vec3{0, 1, 1}}});
     mixed.triangles.push_back({{Vec3{1, 1, 0}, Vec3{1, 0, 1}, Vec3{0, 1, 1}}});

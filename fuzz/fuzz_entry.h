@@ -129,8 +129,8 @@ inline std::optional<std::filesystem::path> partPath(const std::filesystem::path
       return std::nullopt;
   const std::string base = area.lexically_normal().string() + "/";
   const std::filesystem::path full = (folder / name).lexically_normal();
-  if (full.string().compare(0, base.size(), base) != 0 || std::distance(full.begin(), full.end()) >
-                                                              std::distance(area.begin(), area.end()) + 4)
+  if (full.string().compare(0, base.size(), base) != 0 ||
+      std::distance(full.begin(), full.end()) > std::distance(area.begin(), area.end()) + 4)
     return std::nullopt;
   return full;
 }

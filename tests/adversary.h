@@ -23,7 +23,8 @@ class Adversary {
  public:
   Adversary(uint32_t seed, Case c) : rng_(seed), case_(c) {
     for (auto& n : dims_) n = 1 + rng_() % 7;
-    bounds_ = {{c.offset - c.scale, c.offset - c.scale * 0.5, c.offset}, {c.offset + c.scale, c.offset + c.scale, c.offset + 2 * c.scale}};
+    bounds_ = {{c.offset - c.scale, c.offset - c.scale * 0.5, c.offset},
+               {c.offset + c.scale, c.offset + c.scale, c.offset + 2 * c.scale}};
   }
 
   Box cell() {
@@ -42,9 +43,12 @@ class Adversary {
     const double b = cellBoundary(bounds_, dims_, a, i);
     switch (rng_() % 5) {
       case 0:
-      case 1: return b;
-      case 2: return std::nextafter(b, HUGE_VAL);
-      case 3: return std::nextafter(b, -HUGE_VAL);
+      case 1:
+        return b;
+      case 2:
+        return std::nextafter(b, HUGE_VAL);
+      case 3:
+        return std::nextafter(b, -HUGE_VAL);
       default: {
         std::uniform_real_distribution<double> u(bounds_.lo[a] - 0.2 * case_.scale, bounds_.hi[a] + 0.2 * case_.scale);
         return u(rng_);

@@ -108,7 +108,7 @@ TEST(AtomicFile, AbandonedWriteKeepsTheOldOutput) {
     EXPECT_EQ(temporaries(dir.path()).size(), 1u);
     const std::string temp = temporaries(dir.path())[0];
     EXPECT_TRUE(temp.starts_with(".out.tmp") && temp.ends_with(".ply")) << temp;  // hidden, extension kept
-  }  // no commit: as when a writer throws
+  }                                                                               // no commit: as when a writer throws
   EXPECT_EQ(readAll(path), "old");
   EXPECT_TRUE(temporaries(dir.path()).empty());
 }

@@ -200,8 +200,8 @@ TEST_F(ExportTest, ObjSharesVerticesAndGroupsFacesByMaterial) {
   std::multiset<std::pair<Rgb8, std::vector<uint32_t>>> want, got;
   for (size_t f = 0; f < colored.faceCount(); ++f) {
     const auto first = colored.faceVertices.begin();
-    want.insert({colored.faceColors[f],
-                 std::vector<uint32_t>(first + colored.faceStart[f], first + colored.faceStart[f + 1])});
+    want.insert(
+        {colored.faceColors[f], std::vector<uint32_t>(first + colored.faceStart[f], first + colored.faceStart[f + 1])});
   }
   while (std::getline(in, line)) {
     std::istringstream s(line);
@@ -380,7 +380,8 @@ TEST_F(ExportTest, EmptyMeshWritesValidFiles) {
   empty.dims = {2, 2, 2};
   empty.bounds = {{0, 0, 0}, {1, 1, 1}};
   const VoxelMesh mesh = buildVoxelMesh(empty, scene_, FaceMode::Exposed, ColorMode::Count);
-  for (const char* name : {"e.ply", "e.obj", "e.off", "e.glb", "e.gltf"}) EXPECT_NO_THROW(writeVoxelMesh(path(name), mesh)) << name;
+  for (const char* name : {"e.ply", "e.obj", "e.off", "e.glb", "e.gltf"})
+    EXPECT_NO_THROW(writeVoxelMesh(path(name), mesh)) << name;
   tinygltf::Model model;
   tinygltf::TinyGLTF loader;
   std::string err, warn;

@@ -27,7 +27,7 @@ Scene randomScene(std::mt19937_64& rng, int count, double scale, const Vec3& off
   scene.materials.push_back({});
   for (int i = 0; i < count; ++i) {
     Triangle t{{point(), point(), point()}};
-    if (i % 5 == 1) t.v[2] = t.v[0] + (t.v[1] - t.v[0]) * 0.5 + Vec3{0, 0, 1e-9 * scale};  // a sliver
+    if (i % 5 == 1) t.v[2] = t.v[0] + (t.v[1] - t.v[0]) * 0.5 + Vec3{0, 0, 1e-9 * scale};                 // a sliver
     if (i % 3 == 2 && i > 0) t.v[0] = scene.triangles.back().v[1], t.v[1] = scene.triangles.back().v[2];  // a fan
     scene.triangles.push_back(t);
   }
@@ -53,15 +53,22 @@ std::vector<Ray> adversarialRays(std::mt19937_64& rng, const Scene& scene, const
     const Triangle& t = scene.triangles[rng() % scene.triangles.size()];
     Vec3 target;
     switch (i % 6) {
-      case 0: target = t.v[rng() % 3]; break;                                          // a vertex
-      case 1: target = t.v[0] + (t.v[1] - t.v[0]) * u(rng); break;                     // an edge
-      case 2: target = t.v[1] + (t.v[2] - t.v[1]) * u(rng); break;                     // another edge
-      case 3: {                                                                        // an edge, 1 ulp off
+      case 0:
+        target = t.v[rng() % 3];
+        break;  // a vertex
+      case 1:
+        target = t.v[0] + (t.v[1] - t.v[0]) * u(rng);
+        break;  // an edge
+      case 2:
+        target = t.v[1] + (t.v[2] - t.v[1]) * u(rng);
+        break;   // another edge
+      case 3: {  // an edge, 1 ulp off
         const Vec3 p = t.v[2] + (t.v[0] - t.v[2]) * u(rng);
         target = {std::nextafter(p.x, 2 * p.x + 1), p.y, std::nextafter(p.z, -2 * p.z - 1)};
         break;
       }
-      default: target = t.v[0] + (t.v[1] - t.v[0]) * (u(rng) / 3) + (t.v[2] - t.v[0]) * (u(rng) / 3);  // inside
+      default:
+        target = t.v[0] + (t.v[1] - t.v[0]) * (u(rng) / 3) + (t.v[2] - t.v[0]) * (u(rng) / 3);  // inside
     }
     Vec3 origin = grid.bounds.lo + Vec3{u(rng), u(rng), u(rng)} * 1.2 * size - Vec3{0.1, 0.1, 0.1} * size;
     if (i % 7 == 0) origin = target + Vec3{u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5} * 1e6 * size;  // far away
@@ -83,7 +90,8 @@ std::vector<Ray> adversarialRays(std::mt19937_64& rng, const Scene& scene, const
 
 // For every ray and every cell's group: no lane the filter rejects is hit by the double test. Returns how many
 // (ray, triangle) pairs the double test hit, so that callers can check the rays meant something.
-uint64_t expectFilterSound(const Accel& accel, const std::vector<Ray>& rays, uint64_t& rejected, uint64_t& lanesTested) {
+uint64_t expectFilterSound(const Accel& accel, const std::vector<Ray>& rays, uint64_t& rejected,
+                           uint64_t& lanesTested) {
   uint64_t hits = 0;
   const FloatCells& fc = accel.floatCells;
   for (size_t r = 0; r < rays.size(); ++r) {
@@ -171,8 +179,8 @@ TEST(FloatFilter, WalksEqualDoubleOnlyAndBruteForce) {
         hits += a.valid();
         if (grazing[r]) continue;
         ASSERT_EQ(a.prim, c.prim) << "o=(" << ray.origin.x << "," << ray.origin.y << "," << ray.origin.z << ") d=("
-                                  << ray.direction.x << "," << ray.direction.y << "," << ray.direction.z << ") t " << a.t
-                                  << " " << c.t << " tMax " << tMax;
+                                  << ray.direction.x << "," << ray.direction.y << "," << ray.direction.z << ") t "
+                                  << a.t << " " << c.t << " tMax " << tMax;
         ASSERT_EQ(0, std::memcmp(&a.t, &c.t, sizeof(double)));
         ASSERT_EQ(occluded(filtered, ray), occluded(brute, ray));
       }

@@ -211,12 +211,12 @@ TEST(GridFile, BadSolidRunsAndUnknownSectionsAreRefused) {
   opt.dims = {4, 4, 4};
   const Grid grid = voxelizeScene(scene, opt);
   const std::vector<std::vector<CellRun>> bad = {
-      {{0, 0}},             // empty run
-      {{60, 5}},            // past the last cell
-      {{10, 2}, {12, 1}},   // adjacent: must have been one run
-      {{10, 3}, {11, 1}},   // overlapping
-      {{20, 1}, {10, 1}},   // unsorted
-      {{UINT64_MAX, 2}},    // wraps around
+      {{0, 0}},            // empty run
+      {{60, 5}},           // past the last cell
+      {{10, 2}, {12, 1}},  // adjacent: must have been one run
+      {{10, 3}, {11, 1}},  // overlapping
+      {{20, 1}, {10, 1}},  // unsorted
+      {{UINT64_MAX, 2}},   // wraps around
   };
   for (const auto& runs : bad) {
     Grid g = grid;
@@ -304,9 +304,15 @@ TEST(GridFile, MutationsWithValidChecksumDecodeOrThrow) {
     for (int e = 0; e < edits; ++e) {
       const size_t at = 32 + rng() % (m.size() - 32);
       switch (rng() % 3) {
-        case 0: m[at] = char(rng()); break;
-        case 1: m[at] = char(0xff); break;  // large counts and ids
-        default: std::memset(&m[at], 0, std::min<size_t>(8, m.size() - at)); break;
+        case 0:
+          m[at] = char(rng());
+          break;
+        case 1:
+          m[at] = char(0xff);
+          break;  // large counts and ids
+        default:
+          std::memset(&m[at], 0, std::min<size_t>(8, m.size() - at));
+          break;
       }
     }
     if (rng() % 8 == 0) m.resize(32 + rng() % (m.size() - 32));  // truncated, then re-sized in the header

@@ -81,7 +81,8 @@ TEST(GridSectionSolidTextures, RoundTripIsExactAndRendersTheSame) {
     EXPECT_EQ(a.frequency, b.frequency);
     EXPECT_EQ(a.amplitude, b.amplitude);
   }
-  for (size_t i = 0; i < s.materials.size(); ++i) EXPECT_EQ(f.scene.materials[i].solidTexture, s.materials[i].solidTexture);
+  for (size_t i = 0; i < s.materials.size(); ++i)
+    EXPECT_EQ(f.scene.materials[i].solidTexture, s.materials[i].solidTexture);
   RenderOptions ro;
   ro.width = ro.height = 24;
   ro.bounces = 2;

@@ -378,9 +378,9 @@ TEST(GridSet, VoxelFilesFromLayersEqualTheSingleGrids) {
           const std::string what = std::string(c.name) + " in " + std::to_string(bricks[0]) + "x" +
                                    std::to_string(bricks[1]) + "x" + std::to_string(bricks[2]) + " bricks, " +
                                    colorModeName(color) + (format == VoxelFormat::Binvox ? ", binvox" : ", vox");
-          const std::vector<Rgb8> colors =
-              format == VoxelFormat::MagicaVoxel ? occupiedCellColors(c.box->grid, c.box->scene, color)
-                                                 : std::vector<Rgb8>{};
+          const std::vector<Rgb8> colors = format == VoxelFormat::MagicaVoxel
+                                               ? occupiedCellColors(c.box->grid, c.box->scene, color)
+                                               : std::vector<Rgb8>{};
           const VoxelFileReport want = writeVoxelFile(dir.file("want"), format, c.box->grid, colors);
           const VoxelFileReport got = writeGridSetVoxelFile(dir.file("got"), format, path, m, sceneFile, color);
           EXPECT_EQ(slurp(dir.file("got")), slurp(dir.file("want"))) << what;

@@ -228,8 +228,8 @@ TEST(ImportCourse, Scene6_15SolidTexturesAreKept) {
   }
   // The first texture's Transform { UniformScale 2 YRotate 20 XRotate -20 Translate 1.5 -1.5 0 }, composed as
   // the course composes ops (M = M * Op).
-  const Mat4 expected = scaling({2, 2, 2}) * rotation({0, 1, 0}, 20) * rotation({1, 0, 0}, -20) *
-                        translation({1.5, -1.5, 0});
+  const Mat4 expected =
+      scaling({2, 2, 2}) * rotation({0, 1, 0}, 20) * rotation({1, 0, 0}, -20) * translation({1.5, -1.5, 0});
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) EXPECT_NEAR(s.solidTextures[0].transform.m[r][c], expected.m[r][c], 1e-15);
   EXPECT_TRUE(s.warnings.empty());
@@ -877,8 +877,8 @@ TEST(ImportExact, CourseNumbersAndItsTriangleMeshObjComeBackBitForBit) {
       "mesh.txt", courseScene("Group { numObjects 1 MaterialIndex 0\nTriangleMesh { obj_file exact.obj } }\n"));
   expectTrianglesHold(loadScene(meshScene).triangles, values);
   const std::string triScene = dir.write(
-      "tris.txt", courseScene("Group { numObjects " + std::to_string(values.size() / 9) + " MaterialIndex 0\n" +
-                              group + "}\n"));
+      "tris.txt",
+      courseScene("Group { numObjects " + std::to_string(values.size() / 9) + " MaterialIndex 0\n" + group + "}\n"));
   expectTrianglesHold(loadScene(triScene).triangles, values);
   // And the general OBJ importer reads the same file to the same bits.
   expectTrianglesHold(loadScene(dir.file("exact.obj")).triangles, values);
@@ -912,10 +912,9 @@ TEST(ImportExact, ThreeThousandTriangleMeshInstancesLoadInLinearTime) {
 // A PLY file of one triangle per 9 values, vertex x y z of `type`, in `format`.
 std::string plyOf(const std::vector<double>& values, const std::string& format, const std::string& type = "double") {
   const size_t vertices = values.size() / 3;
-  std::string out = "ply\nformat " + format + " 1.0\nelement vertex " + std::to_string(vertices) +
-                    "\nproperty " + type + " x\nproperty " + type + " y\nproperty " + type +
-                    " z\nelement face " + std::to_string(vertices / 3) +
-                    "\nproperty list uchar int vertex_indices\nend_header\n";
+  std::string out = "ply\nformat " + format + " 1.0\nelement vertex " + std::to_string(vertices) + "\nproperty " +
+                    type + " x\nproperty " + type + " y\nproperty " + type + " z\nelement face " +
+                    std::to_string(vertices / 3) + "\nproperty list uchar int vertex_indices\nend_header\n";
   const bool big = format == "binary_big_endian";
   auto put = [&](uint64_t u, int bytes) {
     for (int i = 0; i < bytes; ++i) out += static_cast<char>((u >> (8 * (big ? bytes - 1 - i : i))) & 0xff);

@@ -53,7 +53,7 @@ TEST(InputFile, OnlyRegularFilesAreRead) {
   const fs::path fifo = t.root / "fifo";
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   EXPECT_THROW(readInputFile(fifo.string(), "test file"), InputError);  // refused, not a read that blocks
-  EXPECT_THROW(readInputFile("/dev/zero", "test file"), InputError);     // a device never ends
+  EXPECT_THROW(readInputFile("/dev/zero", "test file"), InputError);    // a device never ends
 }
 
 TEST(InputFile, MemoryBudgetFromTheEnvironment) {
@@ -94,7 +94,8 @@ TEST(CellRange, InfiniteScaleBisects) {
       EXPECT_EQ(r[0], first);
       EXPECT_EQ(r[1], last);
     }
-  const auto all = cellRangeOnAxis(1 << 21, HUGE_VAL, [](int64_t c) { return c * 5e-324; }, 0, 5e-324 * 7);
+  const auto all = cellRangeOnAxis(
+      1 << 21, HUGE_VAL, [](int64_t c) { return c * 5e-324; }, 0, 5e-324 * 7);
   EXPECT_EQ(all[0], 0);
   EXPECT_EQ(all[1], 7);
   const auto nan = cellRangeOnAxis(n, NAN, b, 0, hi);

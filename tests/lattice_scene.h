@@ -91,7 +91,7 @@ inline NearCoincidentPlanes nearCoincidentPlanes(bool forward) {
     c.scene.triangles.push_back(Triangle{{Vec3{x, 0, 0}, Vec3{x, 4, 4}, Vec3{x, 0, 4}}});
   };
   square(forward ? std::nextafter(2.0, 3.0) : std::nextafter(2.0, 1.0));  // B
-  square(2.0);                                                              // A
+  square(2.0);                                                            // A
   c.scene.triangles.push_back(Triangle{{Vec3{0, 0, 0}, Vec3{4, 0, 0}, Vec3{0, 4, 4}}});
   VoxelizeOptions o;
   o.dims = {4, 4, 4};

@@ -313,8 +313,9 @@ TEST(ObjImport, MaterialLibrariesStayInTheObjFolder) {
   EXPECT_EQ(message.rfind(path + ":1: material library: '", 0), 0u) << message;
   EXPECT_NE(message.find("../outside.mtl': lies outside the folder of " + path), std::string::npos) << message;
   path = obj(dir.file("outside.mtl"));
-  EXPECT_NE(inputError([&] { loadScene(path); }).find(":1: material library: '" + dir.file("outside.mtl") +
-                                                      "': absolute paths are refused"),
+  EXPECT_NE(inputError([&] {
+              loadScene(path);
+            }).find(":1: material library: '" + dir.file("outside.mtl") + "': absolute paths are refused"),
             std::string::npos);
   path = obj("sub/../../outside.mtl");
   EXPECT_NE(inputError([&] { loadScene(path); }).find("lies outside the folder"), std::string::npos);
@@ -341,7 +342,8 @@ TEST(ObjImport, MaterialLibrariesStayInTheObjFolder) {
 TEST(ObjImport, OversizedAndNonRegularFilesAreRefused) {
   ScratchDir dir("objr");
   fs::create_directories(dir.path() / "d.obj");
-  EXPECT_EQ(inputError([&] { importObj(dir.file("d.obj")); }), dir.file("d.obj") + ": is a folder, expected the OBJ file");
+  EXPECT_EQ(inputError([&] { importObj(dir.file("d.obj")); }),
+            dir.file("d.obj") + ": is a folder, expected the OBJ file");
   const std::string none = inputError([&] { importObj(dir.file("none.obj")); });
   EXPECT_EQ(none.rfind(dir.file("none.obj") + ": cannot open OBJ file", 0), 0u) << none;
   const std::string path = write(dir, "a.obj", "v 0 0 0\n");

@@ -78,7 +78,7 @@ TEST(OpenEdges, CapsCloseTheMesh) {
   std::swap(flipped[1].v[1], flipped[1].v[2]);
   flipped.push_back(flipped[5]);
   expectCapsClose(flipped, 3);
-  auto lone = cube();  // two disjoint holes on opposite faces
+  auto lone = cube();                          // two disjoint holes on opposite faces
   lone.erase(lone.begin(), lone.begin() + 4);  // z = 0 and z = 1
   const auto b = openBoundaries(lone);
   EXPECT_EQ(b.size(), 2u);

@@ -71,7 +71,8 @@ TEST(OverlapExact, SphereMatchesRationalReference) {
       const Box box = adv.cell();
       Sphere s;
       const int kind = int(adv.rng()() % 4);
-      if (kind == 0) {  // tangent to a face, edge or corner of the cell: centre on a lattice point, radius to a boundary
+      // Kind 0: tangent to a face, edge or corner of the cell (centre on a lattice point, radius to a boundary).
+      if (kind == 0) {
         s.center = adv.point();
         s.radius = std::fabs(box.lo.x - s.center.x);
         if (!(s.radius > 0)) s.radius = c.scale * 0.25;
@@ -102,7 +103,8 @@ TEST(OverlapExact, EllipsoidMatchesReferenceUnderDyadicScaling) {
   int hits = 0;
   const int n = 3000;
   for (int i = 0; i < n; ++i) {
-    const Vec3 s{std::ldexp(1.0, int(rng() % 5) - 2), std::ldexp(1.0, int(rng() % 5) - 2), std::ldexp(1.0, int(rng() % 5) - 2)};
+    const Vec3 s{std::ldexp(1.0, int(rng() % 5) - 2), std::ldexp(1.0, int(rng() % 5) - 2),
+                 std::ldexp(1.0, int(rng() % 5) - 2)};
     const Vec3 t{double(int(rng() % 9) - 4) / 8, double(int(rng() % 9) - 4) / 8, double(int(rng() % 9) - 4) / 8};
     Sphere e;
     e.center = {double(int(rng() % 5) - 2) / 4, double(int(rng() % 5) - 2) / 4, 0.5};

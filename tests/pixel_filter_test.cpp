@@ -11,7 +11,7 @@ namespace {
 
 TEST(PixelFilter, WeightsAndSupports) {
   EXPECT_EQ(filterWeight(FilterKind::Box, 0.5, 0.49, -0.49), 1.0);
-  EXPECT_EQ(filterWeight(FilterKind::Box, 0.5, 0.5, 0), 0.0);  // open square
+  EXPECT_EQ(filterWeight(FilterKind::Box, 0.5, 0.5, 0), 0.0);          // open square
   EXPECT_DOUBLE_EQ(filterWeight(FilterKind::Tent, 2, 0.6, 0.8), 0.5);  // d = 1
   EXPECT_EQ(filterWeight(FilterKind::Tent, 2, 2, 0), 0.0);
   EXPECT_DOUBLE_EQ(filterWeight(FilterKind::Gaussian, 0.4, 0.4, 0), std::exp(-0.5));

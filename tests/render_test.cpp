@@ -38,7 +38,8 @@ int differingPixels(const Image& a, const Image& b) {
   int count = 0;
   for (size_t p = 0; p + a.channels <= a.pixels.size(); p += a.channels) {
     bool same = true;
-    for (uint32_t c = 0; c < a.channels; ++c) same &= std::memcmp(&a.pixels[p + c], &b.pixels[p + c], sizeof(float)) == 0;
+    for (uint32_t c = 0; c < a.channels; ++c)
+      same &= std::memcmp(&a.pixels[p + c], &b.pixels[p + c], sizeof(float)) == 0;
     count += !same;
   }
   return count;
@@ -119,7 +120,8 @@ TEST_P(SeedScene, GridAndBruteForceImagesAreIdentical) {
     const int differ = differingPixels(g, n);
     if (m == OverlapMethod::Center) {
       RecordProperty(std::string("center_differing_pixels_") + c.file, differ);
-      if (differ) std::printf("[ info ] %s center grid: %d of %u pixels differ\n", c.file, differ, ro.width * ro.height);
+      if (differ)
+        std::printf("[ info ] %s center grid: %d of %u pixels differ\n", c.file, differ, ro.width * ro.height);
     } else {
       EXPECT_EQ(differ, 0) << c.file << " " << methodName(m);
     }
@@ -167,7 +169,8 @@ TEST(RenderGridVsBruteForce, RandomScenesAndCamerasInsideAndOutside) {
       ro.camera.orthoHeight = 2.5;
       for (OverlapMethod m : {OverlapMethod::Exact, OverlapMethod::Sat, OverlapMethod::BBox}) {
         const Grid grid = voxelize(scene, {dim(rng), dim(rng), dim(rng)}, m);
-        EXPECT_EQ(differingPixels(render(scene, grid, AccelKind::Grid, ro), render(scene, grid, AccelKind::None, ro)), 0)
+        EXPECT_EQ(differingPixels(render(scene, grid, AccelKind::Grid, ro), render(scene, grid, AccelKind::None, ro)),
+                  0)
             << "seed " << seed << " camera " << cam << " " << methodName(m);
         ++checked;
       }

@@ -263,7 +263,7 @@ TEST(ShadeGridVsBruteForce, RandomReflectiveAndRefractiveScenes) {
       const Image g = render(s, grid, AccelKind::Grid, ro, &gs);
       const Image b = render(s, grid, AccelKind::None, ro, &ns);
       EXPECT_EQ(differingPixels(g, b), 0) << "seed " << seed << " " << methodName(method);
-      EXPECT_EQ(gs.trace.rays, ns.trace.rays);  // the same rays, of every depth
+      EXPECT_EQ(gs.trace.rays, ns.trace.rays);                             // the same rays, of every depth
       EXPECT_GT(gs.trace.rays, 2ull * ro.width * ro.height * ro.samples);  // secondary and shadow rays were traced
     }
   }
@@ -303,8 +303,10 @@ TEST_P(CourseBounces, GridAndBruteForceImagesAreIdentical) {
   // The logo's 13,852 triangles make brute force costly: its wide images are half as wide as the others.
   ro.width = kSanitized ? 24 : (c.wide ? 32 : 64);
   ro.height = c.wide ? ro.width / 2 : ro.width;
-  if (kSanitized) ro.samples = std::min(c.samples, 4u);
-  else ro.samples = c.samples;
+  if (kSanitized)
+    ro.samples = std::min(c.samples, 4u);
+  else
+    ro.samples = c.samples;
   if (c.samples > 1) ro.filter = FilterKind::Gaussian, ro.filterRadius = 0.4;
   ro.bounces = c.bounces;
   ro.weight = 0.01;

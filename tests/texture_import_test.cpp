@@ -24,9 +24,7 @@ namespace {
 
 using testing::ScratchDir;
 
-std::string seed(const std::string& rel) {
-  return std::string(VOX_SEED_DIR) + "/" + rel;
-}
+std::string seed(const std::string& rel) { return std::string(VOX_SEED_DIR) + "/" + rel; }
 
 std::string readAll(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -35,9 +33,7 @@ std::string readAll(const std::string& path) {
   return s.str();
 }
 
-void writeAll(const std::string& path, const std::string& bytes) {
-  std::ofstream(path, std::ios::binary) << bytes;
-}
+void writeAll(const std::string& path, const std::string& bytes) { std::ofstream(path, std::ios::binary) << bytes; }
 
 std::string base64(const std::string& in) {
   static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";

@@ -1,6 +1,7 @@
 // tracePacket must return, for every ray, exactly what traceRay returns (and so what the brute force returns on
-// exact, sat and bbox grids): same primitive, same t bit for bit; occludedPacket what occluded returns. Coherent packets take the slice walk; the tests
-// check that they do (fewer cells than the rays' own walks), so a silent fallback to single rays cannot pass them.
+// exact, sat and bbox grids): same primitive, same t bit for bit; occludedPacket what occluded returns. Coherent
+// packets take the slice walk; the tests check that they do (fewer cells than the rays' own walks), so a silent
+// fallback to single rays cannot pass them.
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -22,8 +23,8 @@ namespace {
 std::string describe(const Ray& r) {
   std::ostringstream s;
   s.precision(17);
-  s << "o=(" << r.origin.x << "," << r.origin.y << "," << r.origin.z << ") d=(" << r.direction.x << ","
-    << r.direction.y << "," << r.direction.z << ") t=[" << r.tMin << "," << r.tMax << "]";
+  s << "o=(" << r.origin.x << "," << r.origin.y << "," << r.origin.z << ") d=(" << r.direction.x << "," << r.direction.y
+    << "," << r.direction.z << ") t=[" << r.tMin << "," << r.tMax << "]";
   return s.str();
 }
 
@@ -56,8 +57,10 @@ PacketCheck expectPacketsMatch(const Accel& grid, const Accel& none, const std::
   for (size_t r = 0; r < rays.size() && failures < 5; ++r) {
     const Hit single = traceRay(grid, rays[r], &rayStats);
     const Hit brute = traceRay(none, rays[r]);
-    const bool same = hits[r].prim == single.prim && std::bit_cast<uint64_t>(hits[r].t) == std::bit_cast<uint64_t>(single.t);
-    const bool sameBrute = single.prim == brute.prim && std::bit_cast<uint64_t>(single.t) == std::bit_cast<uint64_t>(brute.t);
+    const bool same =
+        hits[r].prim == single.prim && std::bit_cast<uint64_t>(hits[r].t) == std::bit_cast<uint64_t>(single.t);
+    const bool sameBrute =
+        single.prim == brute.prim && std::bit_cast<uint64_t>(single.t) == std::bit_cast<uint64_t>(brute.t);
     EXPECT_TRUE(same) << what << " ray " << r << " " << describe(rays[r]) << ": packet prim " << hits[r].prim << " t "
                       << hits[r].t << ", single prim " << single.prim << " t " << single.t;
     EXPECT_TRUE(sameBrute) << what << " ray " << r << " " << describe(rays[r]) << ": single differs from brute force";
@@ -76,7 +79,8 @@ std::vector<Ray> tiledPrimaryRays(const Camera& camera, uint32_t size, uint32_t 
   for (uint32_t ty = 0; ty < size; ty += tile)
     for (uint32_t tx = 0; tx < size; tx += tile)
       for (uint32_t y = ty; y < std::min(ty + tile, size); ++y)
-        for (uint32_t x = tx; x < std::min(tx + tile, size); ++x) rays.push_back(primaryRay(camera, size, size, x + 0.5, y + 0.5));
+        for (uint32_t x = tx; x < std::min(tx + tile, size); ++x)
+          rays.push_back(primaryRay(camera, size, size, x + 0.5, y + 0.5));
   return rays;
 }
 
@@ -164,7 +168,8 @@ TEST(TracePacket, RaysAlongFacesEdgesAndCorners) {
     const Accel none = buildAccel(scene, grid, AccelKind::None);
     // specialRays lists rays in groups that share a direction: packets of them are coherent.
     const std::vector<Ray> rays = testing::specialRays(n, c.scale, c.offset);
-    for (uint32_t size : {2u, 6u, 64u}) expectPacketsMatch(g, none, rays, size, "special rays, scale " + std::to_string(c.scale));
+    for (uint32_t size : {2u, 6u, 64u})
+      expectPacketsMatch(g, none, rays, size, "special rays, scale " + std::to_string(c.scale));
     // Orthographic packets along each axis, on the cell lattice and a hair off it.
     std::vector<Ray> lattice;
     for (int axis = 0; axis < 3; ++axis)
@@ -247,13 +252,15 @@ TEST(TracePacket, OneCellAndLargeGrids) {
   c.center = mid + Vec3{0.3, 0.4, 2.5};
   c.direction = mid - c.center;
   for (const std::array<uint32_t, 3>& dims :
-       {std::array<uint32_t, 3>{1, 1, 1}, std::array<uint32_t, 3>{2048, 2048, 2048}, std::array<uint32_t, 3>{1, 700, 3}}) {
+       {std::array<uint32_t, 3>{1, 1, 1}, std::array<uint32_t, 3>{2048, 2048, 2048},
+        std::array<uint32_t, 3>{1, 700, 3}}) {
     VoxelizeOptions o;
     o.dims = dims;
     const Grid grid = voxelizeScene(scene, o);
     const Accel g = buildAccel(scene, grid, AccelKind::Grid);
     const Accel n = buildAccel(scene, grid, AccelKind::None);
-    expectPacketsMatch(g, n, tiledPrimaryRays(c, 40, 8), 64, "grid " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]));
+    expectPacketsMatch(g, n, tiledPrimaryRays(c, 40, 8), 64,
+                       "grid " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]));
   }
 }
 

@@ -46,7 +46,8 @@ TEST(Tradeoff, SmallModeInvariants) {
             bool held = false;
             if (c >= 0)
               for (uint32_t p : g.cellPrims(size_t(c))) held |= p == t;
-            ASSERT_EQ(held, reference::triangleMeetsBox(ts.scene.triangles[t], box)) << i << " " << j << " " << k << " t " << t;
+            ASSERT_EQ(held, reference::triangleMeetsBox(ts.scene.triangles[t], box))
+                << i << " " << j << " " << k << " t " << t;
           }
         }
   }

@@ -130,8 +130,8 @@ int expectSameHits(const Scene& scene, const Grid& grid, const std::vector<Ray>&
     const Hit a = traceRay(g, rays[r]);
     const Hit b = traceRay(n, rays[r]);
     EXPECT_EQ(a.prim, b.prim) << what << " ray " << r << " o=(" << rays[r].origin.x << "," << rays[r].origin.y << ","
-                              << rays[r].origin.z << ") d=(" << rays[r].direction.x << "," << rays[r].direction.y
-                              << "," << rays[r].direction.z << ")";
+                              << rays[r].origin.z << ") d=(" << rays[r].direction.x << "," << rays[r].direction.y << ","
+                              << rays[r].direction.z << ")";
     if (a.prim == b.prim) {
       EXPECT_EQ(a.t, b.t) << what << " ray " << r;
     }
@@ -198,10 +198,17 @@ Vec3 randomDirection(std::mt19937& rng) {
   // A third of the rays get special components: +-0, -0.0, 1e-30, or exact axis directions.
   for (int a = 0; a < 3; ++a) {
     switch (pick(rng)) {
-      case 0: d.at(a) = 0.0; break;
-      case 1: d.at(a) = -0.0; break;
-      case 2: d.at(a) = (n(rng) > 0 ? 1e-30 : -1e-30); break;
-      default: break;
+      case 0:
+        d.at(a) = 0.0;
+        break;
+      case 1:
+        d.at(a) = -0.0;
+        break;
+      case 2:
+        d.at(a) = (n(rng) > 0 ? 1e-30 : -1e-30);
+        break;
+      default:
+        break;
     }
   }
   if (d.x == 0 && d.y == 0 && d.z == 0) d.z = -1;
@@ -288,7 +295,8 @@ TEST(WalkRobustness, FacesEdgesCornersZeroAndTinyComponents) {
   const std::vector<Ray> rays = specialRays(n);
   const int hits = expectSameHits(scene, grid, rays, "lattice");
   EXPECT_GT(hits, int(rays.size()) / 4);
-  for (size_t r = 0; r < rays.size(); ++r) expectWalkCovers(grid, rays[r], ("special ray " + std::to_string(r)).c_str());
+  for (size_t r = 0; r < rays.size(); ++r)
+    expectWalkCovers(grid, rays[r], ("special ray " + std::to_string(r)).c_str());
 }
 
 TEST(WalkRobustness, RayAlongFaceHitsTriangleLyingInThatFace) {
@@ -343,7 +351,8 @@ TEST(WalkRobustness, RayStartingInsideIgnoresWhatIsBehind) {
   std::vector<Ray> rays;
   for (int i = 0; i < 2000; ++i) rays.push_back(Ray{{u(rng), u(rng), u(rng)}, randomDirection(rng)});
   // Origins exactly on cell boundaries and corners.
-  for (int i = 0; i < 200; ++i) rays.push_back(Ray{{double(i % 11), double(i % 7), double(i % 5)}, randomDirection(rng)});
+  for (int i = 0; i < 200; ++i)
+    rays.push_back(Ray{{double(i % 11), double(i % 7), double(i % 5)}, randomDirection(rng)});
   EXPECT_GT(expectSameHits(scene, grid, rays, "inside"), 400);
   for (size_t r = 0; r < rays.size(); r += 7) expectWalkCovers(grid, rays[r], "inside");
   // tMin > 0 skips near hits on both paths alike.
@@ -369,14 +378,15 @@ TEST(WalkRobustness, Grid2048CubedDiagonalAndAxisRays) {
   for (int i = 0; i < 40; ++i) {
     const double s = 0.3 + 0.4 * u(rng);
     const Vec3 c{s, s + 0.001 * (u(rng) - 0.5), s + 0.001 * (u(rng) - 0.5)};  // near the main diagonal
-    scene.triangles.push_back(Triangle{{c + Vec3{-0.002, -0.002, 0.001}, c + Vec3{0.002, -0.001, -0.001}, c + Vec3{0, 0.002, 0}}});
+    scene.triangles.push_back(
+        Triangle{{c + Vec3{-0.002, -0.002, 0.001}, c + Vec3{0.002, -0.001, -0.001}, c + Vec3{0, 0.002, 0}}});
   }
   const Grid grid = voxelize(scene, {n, n, n}, OverlapMethod::Exact, Box{{0, 0, 0}, {1, 1, 1}});
   const Accel g = buildAccel(scene, grid, AccelKind::Grid);
   const Accel none = buildAccel(scene, grid, AccelKind::None);
-  std::vector<Ray> rays = {Ray{{-0.5, -0.5, -0.5}, {1, 1, 1}},   Ray{{1.5, 1.5, 1.5}, {-1, -1, -1}},
-                           Ray{{0.5, 0.5, 2}, {0, -0.0, -1}},    Ray{{-1, 0.5, 0.5}, {1, 1e-30, -1e-30}},
-                           Ray{{0, 0, 0}, {1, 1, 1}},            Ray{{1, 1, 1}, {-1, -1, -1}}};
+  std::vector<Ray> rays = {Ray{{-0.5, -0.5, -0.5}, {1, 1, 1}}, Ray{{1.5, 1.5, 1.5}, {-1, -1, -1}},
+                           Ray{{0.5, 0.5, 2}, {0, -0.0, -1}},  Ray{{-1, 0.5, 0.5}, {1, 1e-30, -1e-30}},
+                           Ray{{0, 0, 0}, {1, 1, 1}},          Ray{{1, 1, 1}, {-1, -1, -1}}};
   for (int i = 0; i < 200; ++i) {
     const Vec3 target{0.3 + 0.4 * u(rng), 0, 0};
     const Vec3 aim{target.x, target.x + 0.001 * (u(rng) - 0.5), target.x + 0.001 * (u(rng) - 0.5)};
@@ -406,8 +416,8 @@ TEST(WalkRobustness, Grid2048CubedDiagonalAndAxisRays) {
 }
 
 TEST(WalkRobustness, TinySceneAndFarOffsetScene) {
-  for (const auto& [scale, offset] :
-       {std::pair{1e-6 / 8, Vec3{0, 0, 0}}, std::pair{1e-6 / 8, Vec3{1e7, -1e7, 1e7}}, std::pair{1.0, Vec3{1e7, 1e7, 0}}}) {
+  for (const auto& [scale, offset] : {std::pair{1e-6 / 8, Vec3{0, 0, 0}}, std::pair{1e-6 / 8, Vec3{1e7, -1e7, 1e7}},
+                                      std::pair{1.0, Vec3{1e7, 1e7, 0}}}) {
     const int n = 8;
     const Scene scene = latticeScene(n, scale, offset);
     const Grid grid = latticeGrid(scene, n, scale, offset);
@@ -485,12 +495,10 @@ TEST(WalkRobustness, CellTrianglesEqualTrianglesById) {
   EXPECT_TRUE(buildAccel(scene, grid, AccelKind::None).cellTriangles.empty());
 }
 
-
 // ---------------------------------------------------------------------------------------------------------------
 // Exact coverage: the walk visits every cell that the exact ray (rational arithmetic) meets. Checked on rays through
 // (rounded) lattice corners of grids whose boundaries are not representable, over long walks, where an accumulating
 // or misordering walker skips cells.
-
 
 namespace exact {
 using Q = CGAL::Gmpq;
@@ -518,8 +526,10 @@ bool rayMeetsBox(const Ray& ray, const Box& box) {
 // cells of non-empty blocks must be visited.
 void expectExactCoverage(const Grid& g, const Ray& ray, const std::string& what, const Accel* sparse = nullptr) {
   std::optional<GridWalker> walkerStore;
-  if (sparse) walkerStore.emplace(*sparse, ray);
-  else walkerStore.emplace(g.bounds, g.dims, ray);
+  if (sparse)
+    walkerStore.emplace(*sparse, ray);
+  else
+    walkerStore.emplace(g.bounds, g.dims, ray);
   GridWalker& walker = *walkerStore;
   const RayAxes axes = rayAxes(makeCellBoundaries(g.bounds, g.dims), ray);
   std::set<std::array<int64_t, 3>> visited;
@@ -560,8 +570,7 @@ void expectExactCoverage(const Grid& g, const Ray& ray, const std::string& what,
               const double face = side < 0 ? box.lo[a] : box.hi[a];
               // With skipping, the other cell may lie in an empty block: then no primitive meets the face there.
               const bool nIn = n[a] >= 0 && n[a] < int64_t(g.dims[a]);
-              const bool nSkipped =
-                  sparse && nIn && sparse->blockEmpty(uint32_t(n[0]), uint32_t(n[1]), uint32_t(n[2]));
+              const bool nSkipped = sparse && nIn && sparse->blockEmpty(uint32_t(n[0]), uint32_t(n[1]), uint32_t(n[2]));
               inVisitedFace |= ray.origin[a] == face && (visited.count(n) > 0 || nSkipped);
             }
           }

@@ -180,7 +180,7 @@ struct VoxFile {
   };
   std::vector<Model> models;
   std::map<uint32_t, std::array<int64_t, 3>> modelTranslation;  // model id -> "_t" of its transform
-  std::array<std::array<uint8_t, 4>, 256> palette{};           // palette[i] is colour index i + 1
+  std::array<std::array<uint8_t, 4>, 256> palette{};            // palette[i] is colour index i + 1
 };
 
 struct ByteReader {
@@ -221,7 +221,7 @@ VoxFile readVox(const std::string& bytes) {
   const uint32_t children = r.u32();
   EXPECT_EQ(uint64_t(children) + 20, bytes.size());
   std::map<uint32_t, std::pair<uint32_t, std::array<int64_t, 3>>> transforms;  // node -> child, translation
-  std::map<uint32_t, uint32_t> shapes;                                          // node -> model
+  std::map<uint32_t, uint32_t> shapes;                                         // node -> model
   while (r.at + 12 <= bytes.size()) {
     const std::string id = bytes.substr(r.at, 4);
     r.at += 4;
@@ -438,7 +438,7 @@ TEST(Vdb, MergedBoxesKeepTheExactVoxels) {
       const bool box = k >= 2 && k < 31 && j >= 3 && j < 27;  // a 29-layer box of x 5..34
       const uint32_t w = 1 + (j * 7 + k * 3) % 11;            // and rows that change every layer
       const uint32_t i0 = box ? 5 : (k % 4 == 1 ? 0 : 2), n = box ? 30 : w;
-      if (k % 9 == 8 && !box) continue;                      // empty layers
+      if (k % 9 == 8 && !box) continue;  // empty layers
       g.solidRuns.push_back({cellKey(g.dims, i0, j, k), n});
     }
   std::ostringstream out;

@@ -68,8 +68,8 @@ uint64_t edgeKey(uint32_t a, uint32_t b) { return (uint64_t(a) << 32) | b; }
 
 // Everything we check about a closed polygon mesh, computed from the mesh alone.
 struct Topology {
-  bool closed = true;             // every directed edge once, and its reverse once
-  bool vertexManifold = true;     // the faces around every vertex form one cycle
+  bool closed = true;          // every directed edge once, and its reverse once
+  bool vertexManifold = true;  // the faces around every vertex form one cycle
   bool noUnusedVertex = true;
   size_t edges = 0;
   long euler = 0;
@@ -111,7 +111,8 @@ Topology analyse(const VoxelMesh& m, const Vec3& ref) {
   for (size_t f = 0; f < m.faceCount(); ++f) {
     const uint32_t b = m.faceStart[f], e = m.faceStart[f + 1], n = e - b;
     for (uint32_t k = 0; k < n; ++k) {
-      const uint32_t u = m.faceVertices[b + (k + n - 1) % n], v = m.faceVertices[b + k], w = m.faceVertices[b + (k + 1) % n];
+      const uint32_t u = m.faceVertices[b + (k + n - 1) % n], v = m.faceVertices[b + k],
+                     w = m.faceVertices[b + (k + 1) % n];
       cornerNext[edgeKey(v, u)] = w;
     }
   }
@@ -211,7 +212,8 @@ CellSet makeWellComposed(CellSet cells, const std::array<uint32_t, 3>& dims) {
           for (int o = 0; o < 8; ++o) occ |= int(in(x + (o & 1), y + ((o >> 1) & 1), z + (o >> 2))) << o;
           auto fillOne = [&](int o) {
             const Cell c{x + (o & 1), y + ((o >> 1) & 1), z + (o >> 2)};
-            if (c[0] < 0 || c[1] < 0 || c[2] < 0 || c[0] >= int(dims[0]) || c[1] >= int(dims[1]) || c[2] >= int(dims[2]))
+            if (c[0] < 0 || c[1] < 0 || c[2] < 0 || c[0] >= int(dims[0]) || c[1] >= int(dims[1]) ||
+                c[2] >= int(dims[2]))
               return false;
             cells.insert(c);
             return true;
@@ -327,7 +329,7 @@ struct KnownShape {
   const char* name;
   std::array<uint32_t, 3> dims;
   CellSet cells;
-  long euler;  // of the voxel surface, from the shape's construction
+  long euler;       // of the voxel surface, from the shape's construction
   size_t vertices;  // of the exposed mesh, 0 when not checked
 };
 
@@ -418,7 +420,8 @@ TEST(VoxelMesh, ExposedFacesOfACube) {
 TEST(VoxelMesh, RandomSetsAreClosedManifoldsOfTheRightVolume) {
   std::mt19937 rng(7);
   for (int trial = 0; trial < 60; ++trial) {
-    const std::array<uint32_t, 3> dims{uint32_t(2 + trial % 7), uint32_t(2 + (trial / 2) % 6), uint32_t(1 + (trial / 3) % 6)};
+    const std::array<uint32_t, 3> dims{uint32_t(2 + trial % 7), uint32_t(2 + (trial / 2) % 6),
+                                       uint32_t(1 + (trial / 3) % 6)};
     const double density = 0.15 + 0.7 * (trial % 10) / 10.0;
     const CellSet cells = randomCells(rng, dims, density);
     const Grid g = makeGrid(dims, cells);

@@ -61,9 +61,9 @@ int runVoxelFormat(const Options& opt, vox::VoxelFormat format) {
   bar.update(0.2);
   const auto writeStart = std::chrono::steady_clock::now();
   const auto progress = [&](double f) { bar.update(0.2 + 0.8 * f); };
-  const VoxelFileReport report =
-      layered ? writeGridSetVoxelFile(opt.output, format, opt.grid, set, file, color, progress)
-              : writeVoxelFile(opt.output, format, file.grid, colors, progress);
+  const VoxelFileReport report = layered
+                                     ? writeGridSetVoxelFile(opt.output, format, opt.grid, set, file, color, progress)
+                                     : writeVoxelFile(opt.output, format, file.grid, colors, progress);
   const double writeSeconds = secondsSince(writeStart);
   bar.finish();
   if (format == VoxelFormat::Binvox && report.binvoxShiftVoxels > 1e-9 && !opt.common.quiet)
@@ -81,9 +81,8 @@ int runVoxelFormat(const Options& opt, vox::VoxelFormat format) {
                  "voxels: %llu\noccupied_cells: %zu\nsolid_cells: %llu\n%s: %llu\ncolors: %u\n"
                  "palette_colors: %u\noutput_bytes: %llu\nwrite_seconds: %.6f\ntotal_seconds: %.6f\n",
                  (unsigned long long)report.voxels, size_t(occupied), (unsigned long long)solid,
-                 format == VoxelFormat::Vdb ? "vdb_leaf_nodes" : "models",
-                 (unsigned long long)report.models, report.gridColors,
-                 report.paletteColors, (unsigned long long)(sizeError ? 0 : bytes), writeSeconds,
+                 format == VoxelFormat::Vdb ? "vdb_leaf_nodes" : "models", (unsigned long long)report.models,
+                 report.gridColors, report.paletteColors, (unsigned long long)(sizeError ? 0 : bytes), writeSeconds,
                  secondsSince(start));
   }
   return kExitOk;
@@ -146,9 +145,10 @@ int run(const Options& opt) {
 
 int main(int argc, char** argv) {
   Options opt;
-  CLI::App app{"Write the voxels of a grid file (occupied and solid cells) as a mesh for MeshLab, Blender and "
-               "other mesh tools; the format follows the output's extension.",
-               "vox-export"};
+  CLI::App app{
+      "Write the voxels of a grid file (occupied and solid cells) as a mesh for MeshLab, Blender and "
+      "other mesh tools; the format follows the output's extension.",
+      "vox-export"};
   app.add_option("grid", opt.grid, "Input grid file (.vgrid)")->required();
   app.add_option("-o,--output", opt.output,
                  "Output mesh: .ply (binary unless --ascii, face colours), .obj (vertex colours), .off (face "

@@ -11,9 +11,10 @@ int main(int argc, char** argv) {
   std::string path;
   vox::InfoOptions options;
   vox::cli::CommonOptions common;
-  CLI::App app{"Print the bounds, dimensions, method, primitive counts, occupied cells, references, memory and a "
-               "histogram of primitives per cell of a grid file.",
-               "vox-info"};
+  CLI::App app{
+      "Print the bounds, dimensions, method, primitive counts, occupied cells, references, memory and a "
+      "histogram of primitives per cell of a grid file.",
+      "vox-info"};
   app.add_option("grid", path, "Grid file (.vgrid)")->required();
   app.add_flag("--json", options.json, "One JSON object instead of text");
   app.add_flag("--cells", options.cells, "With --json: every occupied cell and its primitive ids")->needs("--json");

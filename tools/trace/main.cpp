@@ -80,7 +80,8 @@ int run(const Options& opt) {
   }
   if (ro.width == 0 || ro.height == 0 || ro.width > kMaxSide || ro.height > kMaxSide ||
       uint64_t(ro.width) * ro.height > kMaxPixels)
-    fail<UsageError>("--size ", ro.width, " ", ro.height, ": each side must be 1..", kMaxSide, " and at most 2^28 pixels");
+    fail<UsageError>("--size ", ro.width, " ", ro.height, ": each side must be 1..", kMaxSide,
+                     " and at most 2^28 pixels");
   if (opt.samples == 0 || opt.samples > kMaxSamples) fail<UsageError>("--samples must be 1..", kMaxSamples);
   if (opt.fov != 0 && !(opt.fov > 0 && opt.fov < 180)) fail<UsageError>("--fov must be between 0 and 180 degrees");
   if (!imageFormatSupported(opt.output))
@@ -153,7 +154,8 @@ int main(int argc, char** argv) {
   app.add_option("--filter", opt.filter, "Reconstruction filter KIND RADIUS: box, tent or gaussian, radius in pixels")
       ->expected(2);
   app.add_flag("--stats", opt.stats, "Print statistics (name: value) on stderr");
-  auto* eye = app.add_option("--eye", opt.eye, "Camera position X Y Z (with --look-at: a perspective camera)")->expected(3);
+  auto* eye =
+      app.add_option("--eye", opt.eye, "Camera position X Y Z (with --look-at: a perspective camera)")->expected(3);
   auto* look = app.add_option("--look-at", opt.lookAt, "Point the camera looks at X Y Z")->expected(3);
   eye->needs(look);
   look->needs(eye);

@@ -154,8 +154,7 @@ std::vector<Outcome> gatherOutcomes(const Outcome& mine, int rank, int size) {
     }
     all.resize(total);
   }
-  MPI_Gatherv(bytes.data(), length, MPI_CHAR, all.data(), lengths.data(), offsets.data(), MPI_CHAR, 0,
-              MPI_COMM_WORLD);
+  MPI_Gatherv(bytes.data(), length, MPI_CHAR, all.data(), lengths.data(), offsets.data(), MPI_CHAR, 0, MPI_COMM_WORLD);
   std::vector<Outcome> out;
   if (rank == 0)
     for (int r = 0; r < size; ++r)
@@ -284,8 +283,8 @@ int runSet(const Options& opt, int rank, int size) {
     for (size_t r = 0; r < all.size() && code == kExitOk; ++r)
       if (all[r].code != kExitOk) {
         code = all[r].code;
-        std::fprintf(stderr, "vox-voxelize-mpi: error: %s%s\n", size > 1 ? ("rank " + std::to_string(r) + ": ").c_str() : "",
-                     all[r].message.c_str());
+        std::fprintf(stderr, "vox-voxelize-mpi: error: %s%s\n",
+                     size > 1 ? ("rank " + std::to_string(r) + ": ").c_str() : "", all[r].message.c_str());
       }
     if (code == kExitOk) {
       std::string message;
@@ -300,8 +299,10 @@ int runSet(const Options& opt, int rank, int size) {
             // The fill needs every brick's cells: rank 0 runs it over the written bricks (fillGridSet).
             if (opt.fill)
               namingScene(opt.scene, [&] {
-                const FillReport report = fillGridSet(opt.output, m, scene, FillOptions{vo.memoryLimitBytes, {}, {}, false});
-                if (!opt.common.quiet) std::fprintf(stderr, "vox-voxelize-mpi: fill: %s\n", describeFill(report).c_str());
+                const FillReport report =
+                    fillGridSet(opt.output, m, scene, FillOptions{vo.memoryLimitBytes, {}, {}, false});
+                if (!opt.common.quiet)
+                  std::fprintf(stderr, "vox-voxelize-mpi: fill: %s\n", describeFill(report).c_str());
               });
             writeGridSetManifest(opt.output, m);
           },
@@ -445,9 +446,10 @@ int main(int argc, char** argv) {
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   Options opt;
-  CLI::App app{"Voxelize over Open MPI ranks: one scene into a grid set (--bricks), or a batch of scenes into one grid "
-               "each (--batch). Run as mpirun -n K vox-voxelize-mpi ...",
-               "vox-voxelize-mpi"};
+  CLI::App app{
+      "Voxelize over Open MPI ranks: one scene into a grid set (--bricks), or a batch of scenes into one grid "
+      "each (--batch). Run as mpirun -n K vox-voxelize-mpi ...",
+      "vox-voxelize-mpi"};
   app.add_option("scene", opt.scene, "Input scene file (with --bricks)");
   app.add_option("--batch", opt.batch, "File listing scenes, one path a line: each becomes DIR/NAME.vgrid");
   app.add_option("-o,--output", opt.output, "Output manifest (.vgrid) with --bricks, output folder with --batch")
@@ -467,8 +469,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1u, vox::kMaxCellsPerAxis));
   app.add_flag("--stats", opt.stats, "Print per-rank work time and peak memory on stderr (rank 0)");
   vox::cli::addCommonOptions(app, opt.common);
-  app.footer("Each rank uses the node's cores divided by the ranks on it unless --threads is given. Exit codes (the "
-             "same on every rank): 0 ok, 1 usage, 2 bad input (a batch: some scene was bad), 3 cannot write.");
+  app.footer(
+      "Each rank uses the node's cores divided by the ranks on it unless --threads is given. Exit codes (the "
+      "same on every rank): 0 ok, 1 usage, 2 bad input (a batch: some scene was bad), 3 cannot write.");
   std::optional<int> early;
   if (rank == 0) {
     early = vox::cli::parse(app, argc, argv);

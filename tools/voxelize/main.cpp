@@ -89,8 +89,8 @@ int runSet(const Options& opt, const vox::Scene& scene, vox::VoxelizeOptions vo,
                  scene.triangles.size(), scene.spheres.size(), scene.planes.size(), set.dims[0], set.dims[1],
                  set.dims[2], methodName(set.method).c_str(), set.bricks[0], set.bricks[1], set.bricks[2],
                  set.entries.size(), (unsigned long long)stats.cellsTested, (unsigned long long)stats.exactFallbacks,
-                 (unsigned long long)occupied, (unsigned long long)solid, (unsigned long long)references, stats.seconds, total,
-                 double(usage.ru_maxrss) / 1024.0);
+                 (unsigned long long)occupied, (unsigned long long)solid, (unsigned long long)references, stats.seconds,
+                 total, double(usage.ru_maxrss) / 1024.0);
   }
   return kExitOk;
 }
@@ -103,7 +103,8 @@ int run(const Options& opt) {
   vo.method = parseMethod(opt.method);
   if (!opt.grid.empty()) vo.dims = std::array<uint32_t, 3>{opt.grid[0], opt.grid[1], opt.grid[2]};
   if (opt.resolution) vo.resolution = opt.resolution;
-  if (!opt.bounds.empty()) vo.bounds = Box{{opt.bounds[0], opt.bounds[1], opt.bounds[2]}, {opt.bounds[3], opt.bounds[4], opt.bounds[5]}};
+  if (!opt.bounds.empty())
+    vo.bounds = Box{{opt.bounds[0], opt.bounds[1], opt.bounds[2]}, {opt.bounds[3], opt.bounds[4], opt.bounds[5]}};
   vo.memoryLimitBytes = memoryBudgetBytes();
 
   // Before the scene is read: `-o scene.glb` would destroy the scene.
@@ -141,7 +142,8 @@ int run(const Options& opt) {
     fail<InputError>(opt.scene, ": ", e.what());
   }
   if (!grid.outsidePrims.empty() && !opt.common.quiet)
-    std::fprintf(stderr, "vox-voxelize: warning: %s: %zu primitives stick out of the given bounds (traced separately)\n",
+    std::fprintf(stderr,
+                 "vox-voxelize: warning: %s: %zu primitives stick out of the given bounds (traced separately)\n",
                  opt.scene.c_str(), grid.outsidePrims.size());
   writeGridFile(opt.output, scene, grid);
 
@@ -156,8 +158,8 @@ int run(const Options& opt) {
                  scene.triangles.size(), scene.spheres.size(), scene.planes.size(),
                  (unsigned long long)stats.degenerateTriangles, grid.dims[0], grid.dims[1], grid.dims[2],
                  methodName(grid.method).c_str(), (unsigned long long)stats.cellsTested,
-                 (unsigned long long)stats.exactFallbacks, grid.occupiedCount(), (unsigned long long)grid.solidCount(), grid.referenceCount(), stats.seconds,
-                 total, double(usage.ru_maxrss) / 1024.0);
+                 (unsigned long long)stats.exactFallbacks, grid.occupiedCount(), (unsigned long long)grid.solidCount(),
+                 grid.referenceCount(), stats.seconds, total, double(usage.ru_maxrss) / 1024.0);
   }
   return kExitOk;
 }

@@ -9,10 +9,14 @@ namespace vox {
 
 std::string methodName(OverlapMethod method) {
   switch (method) {
-    case OverlapMethod::Center: return "center";
-    case OverlapMethod::BBox: return "bbox";
-    case OverlapMethod::Sat: return "sat";
-    case OverlapMethod::Exact: return "exact";
+    case OverlapMethod::Center:
+      return "center";
+    case OverlapMethod::BBox:
+      return "bbox";
+    case OverlapMethod::Sat:
+      return "sat";
+    case OverlapMethod::Exact:
+      return "exact";
   }
   return "unknown";
 }

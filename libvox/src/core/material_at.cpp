@@ -81,9 +81,7 @@ void validateTexture(const SolidTexture& t, size_t i, size_t materials, const st
 
 }  // namespace
 
-Material materialAt(const Scene& scene, uint32_t id, const Vec3& p) {
-  return resolve(scene, id, p, 0);
-}
+Material materialAt(const Scene& scene, uint32_t id, const Vec3& p) { return resolve(scene, id, p, 0); }
 
 void validateSolidTextures(const Scene& scene, const std::string& source) {
   for (size_t i = 0; i < scene.solidTextures.size(); ++i)

@@ -7,8 +7,10 @@
 namespace vox {
 
 ProgressBar::ProgressBar(std::string label, bool quiet)
-    : label_(std::move(label)), enabled_(!quiet && ::isatty(STDERR_FILENO)),
-      start_(std::chrono::steady_clock::now()), lastDraw_(start_) {}
+    : label_(std::move(label)),
+      enabled_(!quiet && ::isatty(STDERR_FILENO)),
+      start_(std::chrono::steady_clock::now()),
+      lastDraw_(start_) {}
 
 ProgressBar::~ProgressBar() { finish(); }
 

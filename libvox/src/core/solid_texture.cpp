@@ -18,17 +18,22 @@ double solidTextureWeight(const SolidTexture& t, const Vec3& world) {
     case SolidKind::Marble:
       return 0.5 * (1 + std::sin(t.frequency * p.x + t.amplitude * octaveNoise(p, t.octaves)));
     case SolidKind::Wood:
-      return 0.5 * (1 + std::sin(t.frequency * std::sqrt(p.x * p.x + p.z * p.z) + t.amplitude * octaveNoise(p, t.octaves)));
+      return 0.5 *
+             (1 + std::sin(t.frequency * std::sqrt(p.x * p.x + p.z * p.z) + t.amplitude * octaveNoise(p, t.octaves)));
   }
   return 1;
 }
 
 const char* solidKindName(SolidKind kind) {
   switch (kind) {
-    case SolidKind::Checkerboard: return "checkerboard";
-    case SolidKind::Noise: return "noise";
-    case SolidKind::Marble: return "marble";
-    case SolidKind::Wood: return "wood";
+    case SolidKind::Checkerboard:
+      return "checkerboard";
+    case SolidKind::Noise:
+      return "noise";
+    case SolidKind::Marble:
+      return "marble";
+    case SolidKind::Wood:
+      return "wood";
   }
   return "unknown";
 }

@@ -61,9 +61,7 @@ Taps taps(double t, uint32_t n, TextureWrap mode) {
 
 }  // namespace
 
-double srgbToLinear(uint8_t encoded) {
-  return srgbTable()[encoded];
-}
+double srgbToLinear(uint8_t encoded) { return srgbTable()[encoded]; }
 
 double linearToSrgb(double linear) {
   if (!(linear > 0)) return 0;  // also NaN

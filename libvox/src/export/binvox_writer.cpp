@@ -139,7 +139,8 @@ BinvoxLayout writeBinvox(std::ostream& out, const Grid& plan, const VoxelRowSour
   RunEncoder enc(out);
   std::vector<uint64_t> plane((planeBits + 63) / 64, 0);
   for (uint64_t x = 0; x < d; ++x) {
-    for (uint64_t e = eventStart[x]; e < eventStart[x + 1]; ++e) plane[events[e] / 64] ^= uint64_t(1) << (events[e] % 64);
+    for (uint64_t e = eventStart[x]; e < eventStart[x + 1]; ++e)
+      plane[events[e] / 64] ^= uint64_t(1) << (events[e] % 64);
     encodePlane(plane, planeBits, enc);
     if (progress && x % 64 == 0) progress(double(x) / double(d));
   }

@@ -125,8 +125,8 @@ class VoxelMeshExporter : public OM::IO::BaseExporter {
     // Newell's method: exact direction for planar polygons, any number of vertices.
     Vec3 n;
     const uint32_t b = mesh_.faceStart[size_t(f.idx())], e = mesh_.faceStart[size_t(f.idx()) + 1];
-    for (uint32_t k = b; k < e; ++k) n = n + cross(mesh_.positions[mesh_.faceVertices[k]],
-                                                 mesh_.positions[mesh_.faceVertices[k + 1 < e ? k + 1 : b]]);
+    for (uint32_t k = b; k < e; ++k)
+      n = n + cross(mesh_.positions[mesh_.faceVertices[k]], mesh_.positions[mesh_.faceVertices[k + 1 < e ? k + 1 : b]]);
     n = normalize(n);
     return OM::Vec3d(n.x, n.y, n.z);
   }
@@ -448,7 +448,7 @@ void writeGltf(OutputFile& out, const VoxelMesh& polygons, bool binary) {
         const Rgb8& c = mesh.faceColors[order[runStart[r] / 3]];
         material.name = materialName(c);
         material.pbrMetallicRoughness.baseColorFactor = {srgbToLinear(c[0]), srgbToLinear(c[1]), srgbToLinear(c[2]),
-                                                          1.0};
+                                                         1.0};
       } else {
         material.name = "voxels";
       }
@@ -497,8 +497,12 @@ void writeVoxelMesh(const std::string& path, const VoxelMesh& mesh, bool binary)
     opt += OM::IO::Options::VertexColor;
   }
   switch (format) {
-    case MeshFormat::Ply: writeWithOpenMesh(out, ".ply", mesh, opt, dominantVertexColors(mesh)); break;
-    case MeshFormat::Off: writeOff(out, mesh); break;
+    case MeshFormat::Ply:
+      writeWithOpenMesh(out, ".ply", mesh, opt, dominantVertexColors(mesh));
+      break;
+    case MeshFormat::Off:
+      writeOff(out, mesh);
+      break;
     case MeshFormat::Stl:
       writeWithOpenMesh(out, ".stl", mesh.isTriangleMesh() ? mesh : triangulateVoxelMesh(mesh), opt);
       break;
@@ -506,8 +510,12 @@ void writeVoxelMesh(const std::string& path, const VoxelMesh& mesh, bool binary)
       writeObj(out, mesh, mtl ? std::filesystem::path(mtl->path()).filename().string() : std::string());
       if (mtl) mtl->commit();
       break;
-    case MeshFormat::Glb: writeGltf(out, mesh, true); break;
-    case MeshFormat::Gltf: writeGltf(out, mesh, false); break;
+    case MeshFormat::Glb:
+      writeGltf(out, mesh, true);
+      break;
+    case MeshFormat::Gltf:
+      writeGltf(out, mesh, false);
+      break;
   }
   out.commit();
 }

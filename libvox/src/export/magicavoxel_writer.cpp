@@ -340,7 +340,8 @@ MagicaVoxelStats writeMagicaVoxelPieces(std::ostream& out, const Grid& plan, con
   const std::string graph = sceneGraph(tiles);
   children += graph.size() + 12 + 1024;  // scene graph, RGBA chunk
   if (children > uint64_t(INT32_MAX) - 20)
-    fail<LimitError>("vox: ", stats.voxels, " voxels need ", children, " bytes, more than the 2^31 - 1 that the "
+    fail<LimitError>("vox: ", stats.voxels, " voxels need ", children,
+                     " bytes, more than the 2^31 - 1 that the "
                      "format's int32 chunk sizes allow (export a coarser grid or several bricks)");
   checkMemory(double(slabMax) * 4, "vox", "one 256-cell slab of voxels");
 

@@ -74,7 +74,7 @@ class DensityBuilder {
   }
 
  private:
-  using Span = std::pair<uint32_t, uint32_t>;  // i0, count
+  using Span = std::pair<uint32_t, uint32_t>;                   // i0, count
   using Rect = std::pair<Span, std::pair<uint32_t, uint32_t>>;  // x span, y range [j0, j1]
 
   void endLayer() {
@@ -114,8 +114,8 @@ class DensityBuilder {
   openvdb::FloatGrid::Ptr density_, slab_;
   int64_t layer_ = -1, boxLayer_ = -2, slabK_ = -1;
   std::map<Span, std::pair<uint32_t, uint32_t>> rows_;  // open rectangles of this layer, by x span
-  std::vector<Rect> rects_;                              // closed rectangles of this layer
-  std::map<Rect, uint32_t> boxes_;                       // boxes open up to boxLayer_
+  std::vector<Rect> rects_;                             // closed rectangles of this layer
+  std::map<Rect, uint32_t> boxes_;                      // boxes open up to boxLayer_
 };
 
 openvdb::FloatGrid::Ptr buildDensity(const Grid& grid, const std::function<void(double)>& progress) {

@@ -53,8 +53,7 @@ ColoredPieceSource setPieces(const std::string& setPath, const GridSetManifest& 
   uint32_t maxCount = 0;
   if (color == ColorMode::Count)
     for (size_t i = 0; i < set.entries.size(); ++i)
-      maxCount =
-          std::max(maxCount, largestCellCount(readBrick(setPath, set, i, sceneFile.scene.boundedCount())));
+      maxCount = std::max(maxCount, largestCellCount(readBrick(setPath, set, i, sceneFile.scene.boundedCount())));
   return [&setPath, &set, &sceneFile, color, cells, maxCount](const ColoredPieceVisitor& visit) {
     forEachGridSetLayer(
         setPath, set, sceneFile,

@@ -53,18 +53,24 @@ ColorMode parseColorMode(const std::string& name) {
 
 std::string faceModeName(FaceMode mode) {
   switch (mode) {
-    case FaceMode::All: return "all";
-    case FaceMode::Exposed: return "exposed";
-    case FaceMode::Merged: return "merged";
+    case FaceMode::All:
+      return "all";
+    case FaceMode::Exposed:
+      return "exposed";
+    case FaceMode::Merged:
+      return "merged";
   }
   return "unknown";
 }
 
 std::string colorModeName(ColorMode mode) {
   switch (mode) {
-    case ColorMode::Count: return "count";
-    case ColorMode::Material: return "material";
-    case ColorMode::None: return "none";
+    case ColorMode::Count:
+      return "count";
+    case ColorMode::Material:
+      return "material";
+    case ColorMode::None:
+      return "none";
   }
   return "unknown";
 }
@@ -173,7 +179,8 @@ struct Lattice {
 };
 
 void checkVertexCount(uint64_t n) {
-  if (n >= (uint64_t(1) << 32)) fail<LimitError>("voxel mesh: ", n, " vertices exceed the 2^32 limit of the mesh formats");
+  if (n >= (uint64_t(1) << 32))
+    fail<LimitError>("voxel mesh: ", n, " vertices exceed the 2^32 limit of the mesh formats");
 }
 
 // ---------------------------------------------------------------------------------------------------------------
@@ -251,9 +258,9 @@ EdgeSlots edgeSlots(int a, int side) {
 }
 
 struct PointTables {
-  std::array<uint8_t, 256> checkerEdges{};               // bit e: edge e has four faces
-  std::vector<std::array<uint8_t, 12>> cycle;            // [config][slot] -> cycle id or kNoCycle
-  std::vector<uint8_t> cycleCount;                       // [config]
+  std::array<uint8_t, 256> checkerEdges{};     // bit e: edge e has four faces
+  std::vector<std::array<uint8_t, 12>> cycle;  // [config][slot] -> cycle id or kNoCycle
+  std::vector<uint8_t> cycleCount;             // [config]
   std::array<EdgeSlots, 6> edges;
 
   PointTables() : cycle(1 << 14), cycleCount(1 << 14, 0) {
@@ -328,8 +335,8 @@ const PointTables& pointTables() {
 // Bricks.
 
 constexpr int kBrickBits = 3;
-constexpr int kBrick = 1 << kBrickBits;  // 8 cells per brick edge
-constexpr int kPadLo = 2, kPadHi = 2;    // cells copied around a brick: vertex decisions look two cells down
+constexpr int kBrick = 1 << kBrickBits;         // 8 cells per brick edge
+constexpr int kPadLo = 2, kPadHi = 2;           // cells copied around a brick: vertex decisions look two cells down
 constexpr int kPad = kBrick + kPadLo + kPadHi;  // 12
 constexpr int kKeyBits = 21;
 constexpr uint64_t kKeyMask = (uint64_t(1) << kKeyBits) - 1;
@@ -371,8 +378,9 @@ BrickSet buildBricks(const Voxels& vox, const std::array<uint32_t, 3>& dims) {
                     uint32_t((ijk[0] & 7) | ((ijk[1] & 7) << 3) | ((ijk[2] & 7) << 6)), vox.colors[v]};
     }
   });
-  tbb::parallel_sort(entries.begin(), entries.end(),
-                     [](const Entry& a, const Entry& b) { return a.brick != b.brick ? a.brick < b.brick : a.local < b.local; });
+  tbb::parallel_sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+    return a.brick != b.brick ? a.brick < b.brick : a.local < b.local;
+  });
   BrickSet set;
   set.colors.resize(entries.size());
   for (size_t v = 0; v < entries.size(); ++v) {
@@ -497,7 +505,8 @@ ExposedSurface buildExposed(const Voxels& vox, const Lattice& lat) {
   for (const Brick& b : set.bricks) {
     const auto c = brickCoords(b.key);
     for (int d = 0; d < 8; ++d)
-      workKeys.push_back(brickKey(uint64_t(c[0] + (d & 1)), uint64_t(c[1] + ((d >> 1) & 1)), uint64_t(c[2] + (d >> 2))));
+      workKeys.push_back(
+          brickKey(uint64_t(c[0] + (d & 1)), uint64_t(c[1] + ((d >> 1) & 1)), uint64_t(c[2] + (d >> 2))));
   }
   tbb::parallel_sort(workKeys.begin(), workKeys.end());
   workKeys.erase(std::unique(workKeys.begin(), workKeys.end()), workKeys.end());
@@ -562,7 +571,8 @@ ExposedSurface buildExposed(const Voxels& vox, const Lattice& lat) {
       // Work-brick indices of this brick and its upper neighbours, which own the corners at local coordinate 8.
       std::array<uint32_t, 8> owner;
       for (int d = 0; d < 8; ++d) {
-        auto it = workIndex.find(brickKey(uint64_t(bc[0] + (d & 1)), uint64_t(bc[1] + ((d >> 1) & 1)), uint64_t(bc[2] + (d >> 2))));
+        auto it = workIndex.find(
+            brickKey(uint64_t(bc[0] + (d & 1)), uint64_t(bc[1] + ((d >> 1) & 1)), uint64_t(bc[2] + (d >> 2))));
         owner[d] = it->second;  // present by construction of workKeys
       }
       configCache.fill(-1);
@@ -754,7 +764,8 @@ VoxelMesh mergedMesh(ExposedSurface&& surface, const std::array<uint32_t, 3>& di
         rowStart.push_back(j);
       }
       const uint32_t h = uint32_t(rowStart.size());
-      for (size_t r = 0; r < h; ++r) std::fill(used.begin() + ptrdiff_t(rowStart[r]), used.begin() + ptrdiff_t(rowStart[r] + w), 1);
+      for (size_t r = 0; r < h; ++r)
+        std::fill(used.begin() + ptrdiff_t(rowStart[r]), used.begin() + ptrdiff_t(rowStart[r] + w), 1);
       // Boundary lattice points counter-clockwise about +axis in (u, v): along v = 0, u = w, v = h, u = 0.
       auto vertexAt = [&](uint32_t du, uint32_t dv) {
         const uint32_t cu = std::min(du, w - 1), cv = std::min(dv, h - 1);
@@ -970,10 +981,13 @@ VoxelMesh triangulateVoxelMesh(const VoxelMesh& mesh) {
       for (size_t k = 0; k < n && rect; ++k) {
         const int in = segmentAxis(mesh.positions[poly[(k + n - 1) % n]], mesh.positions[poly[k]]);
         const int outAxis = segmentAxis(mesh.positions[poly[k]], mesh.positions[poly[(k + 1) % n]]);
-        if (in < 0 || outAxis < 0) rect = false;
+        if (in < 0 || outAxis < 0)
+          rect = false;
         else if (in != outAxis) {
-          if (corners == 4) rect = false;
-          else corner[corners++] = k;
+          if (corners == 4)
+            rect = false;
+          else
+            corner[corners++] = k;
         }
       }
       if (rect && corners == 4) {

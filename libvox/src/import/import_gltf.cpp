@@ -36,8 +36,8 @@
 namespace vox {
 namespace {
 
-bool keepImageBytes(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
-                    const unsigned char* bytes, int size, void*) {
+bool keepImageBytes(tinygltf::Image* image, const int, std::string*, std::string*, int, int, const unsigned char* bytes,
+                    int size, void*) {
   if (image->bufferView != -1 || size <= 0) return true;  // bufferView images: see GltfReader::imageBytes
   image->image.assign(bytes, bytes + size);
   return true;
@@ -163,10 +163,14 @@ class GltfReader {
 
   static TextureWrap wrapMode(int glMode) {
     switch (glMode) {
-      case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return TextureWrap::ClampToEdge;
-      case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return TextureWrap::MirroredRepeat;
-      case TINYGLTF_TEXTURE_WRAP_REPEAT: return TextureWrap::Repeat;
-      default: return TextureWrap(255);
+      case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE:
+        return TextureWrap::ClampToEdge;
+      case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT:
+        return TextureWrap::MirroredRepeat;
+      case TINYGLTF_TEXTURE_WRAP_REPEAT:
+        return TextureWrap::Repeat;
+      default:
+        return TextureWrap(255);
     }
   }
 
@@ -248,9 +252,8 @@ class GltfReader {
     const tinygltf::Accessor& a = model_.accessors[static_cast<size_t>(accessorIndex)];
     const int ct = a.componentType;
     const bool isFloat = ct == TINYGLTF_COMPONENT_TYPE_FLOAT;
-    if (a.type != TINYGLTF_TYPE_VEC2 ||
-        !(isFloat || (a.normalized && (ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
-                                       ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT))))
+    if (a.type != TINYGLTF_TYPE_VEC2 || !(isFloat || (a.normalized && (ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                                                                       ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT))))
       failHere("accessor ", accessorIndex, ": TEXCOORD must be VEC2 of float or normalized unsigned byte or short");
     const size_t size = componentSize(ct);
     const View view = accessorView(accessorIndex, 2 * size);
@@ -767,10 +770,12 @@ Scene importGltf(const std::string& path) {
   tinygltf::Model model;
   std::string err, warn;
   std::error_code ec;
-  const std::string baseDir = std::filesystem::weakly_canonical(std::filesystem::absolute(path), ec).parent_path().string();
+  const std::string baseDir =
+      std::filesystem::weakly_canonical(std::filesystem::absolute(path), ec).parent_path().string();
   const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
-  const bool ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, unsigned(bytes.size()), baseDir)
-                         : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), baseDir);
+  const bool ok = binary
+                      ? loader.LoadBinaryFromMemory(&model, &err, &warn, data, unsigned(bytes.size()), baseDir)
+                      : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), baseDir);
   if (!guard.refusal.empty()) throw InputError(guard.refusal);
   if (!ok) {
     std::string message;

@@ -94,7 +94,7 @@ struct PlyHeader {
   std::string format;
   std::vector<PlyElement> elements;
   size_t bodyStart = 0;  // byte offset of the first byte after end_header's line
-  long long lines = 0;       // header lines, so that the body's first line is lines + 1
+  long long lines = 0;   // header lines, so that the body's first line is lines + 1
 };
 
 // Reads one header line's property into `e`; false when malformed.
@@ -129,9 +129,7 @@ PlyHeader parseHeader(const std::string& data, const std::string& path) {
     std::istringstream words(line);
     std::vector<std::string> w;
     for (std::string word; words >> word;) w.push_back(word);
-    auto bad = [&]() {
-      fail<InputError>(path, ":", lineNumber, ": malformed PLY header line ", quotedWord(line));
-    };
+    auto bad = [&]() { fail<InputError>(path, ":", lineNumber, ": malformed PLY header line ", quotedWord(line)); };
     if (lineNumber == 1) {
       if (w.size() != 1 || w[0] != "ply") fail<InputError>(path, ": not a PLY file (first line is not 'ply')");
     } else if (lineNumber == 2) {
@@ -231,8 +229,7 @@ class AsciiCursor {
     const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
     if (s.empty() || s[0] == '+' || ec != std::errc() || end != s.data() + s.size() || !std::isfinite(v))
       failHere("bad number ", quotedWord(token));
-    if (t == PlyType::Float32 && std::fabs(v) > FLT_MAX)
-      failHere("value ", token, " does not fit in a float property");
+    if (t == PlyType::Float32 && std::fabs(v) > FLT_MAX) failHere("value ", token, " does not fit in a float property");
     return v;
   }
 
@@ -268,8 +265,7 @@ class AsciiCursor {
       failHere("bad ", typeName(t), " value ", quotedWord(token));
     long long lo = 0, hi = 0;
     integerRange(t, lo, hi);
-    if (tooLarge || v < lo || v > hi)
-      failHere("value ", token, " does not fit in a ", typeName(t), " property");
+    if (tooLarge || v < lo || v > hi) failHere("value ", token, " does not fit in a ", typeName(t), " property");
     return v;
   }
 

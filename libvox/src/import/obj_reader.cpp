@@ -140,8 +140,8 @@ class ObjParser {
     } else if (keyword == "mtllib") {
       for (std::string_view w = words.next(); !w.empty(); w = words.next())
         data_.libraries.push_back({std::string(w), line});
-    } else if (keyword == "vn" || keyword == "vp" || keyword == "o" || keyword == "g" ||
-               keyword == "s" || keyword == "l" || keyword == "p") {
+    } else if (keyword == "vn" || keyword == "vp" || keyword == "o" || keyword == "g" || keyword == "s" ||
+               keyword == "l" || keyword == "p") {
       // Texture coordinates, normals, names, smoothing groups, lines and points: nothing a voxelizer uses.
     } else if (unknownCount_++ == 0) {
       firstUnknown_ = std::string(keyword);

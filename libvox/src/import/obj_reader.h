@@ -48,7 +48,7 @@ struct ObjData {
   std::vector<std::array<uint32_t, 3>> triangles;
   std::vector<uint32_t> triangleMaterial;
   std::vector<std::string> materialNames;  // `usemtl` names, in order of first use
-  std::vector<long long> materialLines;        // the line of each name's first `usemtl`
+  std::vector<long long> materialLines;    // the line of each name's first `usemtl`
   std::vector<ObjLibrary> libraries;       // every `mtllib` file name, in file order
   std::vector<TexCoord> texcoords;         // `vt` as written (u, v with v upwards, OBJ's convention)
   // Empty when no face has texture coordinates; else one entry per triangle: indices into `texcoords`, all in

@@ -76,7 +76,8 @@ class ByteReader {
   [[noreturn]] void corrupt(const std::string& what) const { fail<InputError>(name_, ": byte ", pos_, ": ", what); }
 
   void need(uint64_t n) const {
-    if (n > data_.size() - pos_) fail<InputError>(name_, ": truncated at byte ", data_.size(), " (needed ", n, " more bytes at byte ", pos_, ")");
+    if (n > data_.size() - pos_)
+      fail<InputError>(name_, ": truncated at byte ", data_.size(), " (needed ", n, " more bytes at byte ", pos_, ")");
   }
   template <typename T>
   T get() {
@@ -109,7 +110,8 @@ class ByteReader {
   // before anything is allocated.
   uint64_t getCount(size_t elementSize, const char* what) {
     const uint64_t n = get<uint64_t>();
-    if (n > (data_.size() - pos_) / elementSize) corrupt(std::string(what) + " count " + std::to_string(n) + " exceeds the file");
+    if (n > (data_.size() - pos_) / elementSize)
+      corrupt(std::string(what) + " count " + std::to_string(n) + " exceeds the file");
     return n;
   }
   template <typename T>

@@ -12,7 +12,8 @@
 #include "io/byte_codec.h"
 #include "io/grid_sections.h"
 
-static_assert(std::endian::native == std::endian::little, "grid files are little-endian; big-endian hosts need byte swaps");
+static_assert(std::endian::native == std::endian::little,
+              "grid files are little-endian; big-endian hosts need byte swaps");
 
 namespace vox {
 
@@ -116,7 +117,8 @@ void getSections(ByteReader& r, Scene& scene, Grid& grid) {
     r.need(size);
     size_t c = 0;
     while (c < sectionCodecs().size() && uint32_t(sectionCodecs()[c].tag) != tag) ++c;
-    if (c == sectionCodecs().size()) r.corrupt("unknown section tag " + std::to_string(tag) + " (written by a newer libvox?)");
+    if (c == sectionCodecs().size())
+      r.corrupt("unknown section tag " + std::to_string(tag) + " (written by a newer libvox?)");
     const SectionCodec& codec = sectionCodecs()[c];
     if (seen[c]) r.corrupt(std::string("repeated ") + codec.name + " section");
     seen[c] = true;
@@ -224,8 +226,8 @@ void streamPayload(const Scene& scene, const Grid& grid, const ByteWriter::Sink&
 
 std::string encodeGridFile(const Scene& scene, const Grid& grid) {
   ByteWriter w;
-  w.bytes().reserve(kHeaderSize + 256 + scene.triangles.size() * 76 + grid.cellKeys.size() * 16 + grid.primIds.size() * 4 +
-                    scene.materials.size() * 128);
+  w.bytes().reserve(kHeaderSize + 256 + scene.triangles.size() * 76 + grid.cellKeys.size() * 16 +
+                    grid.primIds.size() * 4 + scene.materials.size() * 128);
   w.bytes().assign(kHeaderSize, '\0');  // the header is filled in last, in place, so the payload is never copied
   encodePayload(w, scene, grid);
   std::string bytes = std::move(w.bytes());
@@ -248,8 +250,10 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
   const uint64_t expected = header.get<uint64_t>();
   if (payloadSize != bytes.size() - kHeaderSize) {
     if (payloadSize > bytes.size() - kHeaderSize)
-      fail<InputError>(name, ": truncated at byte ", bytes.size(), " (header promises ", payloadSize + kHeaderSize, " bytes)");
-    fail<InputError>(name, ": ", bytes.size() - kHeaderSize - payloadSize, " unexpected bytes after the end of the grid");
+      fail<InputError>(name, ": truncated at byte ", bytes.size(), " (header promises ", payloadSize + kHeaderSize,
+                       " bytes)");
+    fail<InputError>(name, ": ", bytes.size() - kHeaderSize - payloadSize,
+                     " unexpected bytes after the end of the grid");
   }
   if (wordChecksum(bytes.data() + kHeaderSize, payloadSize) != expected)
     fail<InputError>(name, ": checksum mismatch: the file is corrupt");
@@ -353,7 +357,8 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
     if (grid.cellKeys[c] >= cells || (c > 0 && grid.cellKeys[c] <= grid.cellKeys[c - 1]))
       bad("cell keys not sorted or outside the grid");
   if (grid.cellStart.size() != grid.cellKeys.size() + 1) bad("cell offsets do not match the cell count");
-  if (grid.cellStart.front() != 0 || grid.cellStart.back() != grid.primIds.size()) bad("cell offsets do not cover the references");
+  if (grid.cellStart.front() != 0 || grid.cellStart.back() != grid.primIds.size())
+    bad("cell offsets do not cover the references");
   // Every offset is checked before any primitive range is walked: offsets that run backwards or past the
   // references would otherwise send the walk outside primIds.
   for (size_t c = 0; c + 1 < grid.cellStart.size(); ++c)

@@ -13,9 +13,7 @@
 
 namespace vox {
 
-bool hasTexturesSection(const Scene& scene, const Grid&) {
-  return !scene.textures.empty();
-}
+bool hasTexturesSection(const Scene& scene, const Grid&) { return !scene.textures.empty(); }
 
 void putTexturesSection(ByteWriter& w, const Scene& scene, const Grid&) {
   w.put(uint64_t(scene.textures.size()));

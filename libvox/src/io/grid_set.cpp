@@ -120,8 +120,9 @@ std::string encodeGridSetManifest(const GridSetManifest& m) {
 GridSetManifest decodeGridSetManifest(const std::string& bytes, const std::string& name) {
   if (bytes.size() >= 12 && std::memcmp(bytes.data(), kSetMagic, 8) == 0 && bytes[8] == 1 && bytes[9] == 0 &&
       bytes[10] == 0 && bytes[11] == 0)
-    fail<InputError>(name, ": grid-set version 1 (every brick carried the whole scene) is no longer read: "
-                           "voxelize the scene again with --bricks");
+    fail<InputError>(name,
+                     ": grid-set version 1 (every brick carried the whole scene) is no longer read: "
+                     "voxelize the scene again with --bricks");
   checkSetHeader(bytes, name, kSetMagic, kGridSetVersion, "grid-set manifest");
   GridSetManifest m;
   ByteReader p(bytes, kSetHeaderSize, name);
@@ -330,7 +331,8 @@ bool isGridSet(const std::string& path) {
   char magic[8] = {};
   in.read(magic, 8);
   if (in.gcount() == 8 && std::memcmp(magic, kBrickMagic, 8) == 0)
-    fail<InputError>(path, ": a brick of a grid set, not a grid: open the set's manifest (NAME.vgrid beside NAME.bricks/)");
+    fail<InputError>(path,
+                     ": a brick of a grid set, not a grid: open the set's manifest (NAME.vgrid beside NAME.bricks/)");
   return in.gcount() == 8 && std::memcmp(magic, kSetMagic, 8) == 0;
 }
 

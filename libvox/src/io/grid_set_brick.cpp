@@ -43,7 +43,8 @@ void checkCells(const Grid& g, const CellWindow& w, uint64_t bounded, const std:
           ") outside its brick");
   }
   if (g.cellStart.size() != g.cellKeys.size() + 1) bad("cell offsets do not match the cell count");
-  if (g.cellStart.front() != 0 || g.cellStart.back() != g.primIds.size()) bad("cell offsets do not cover the references");
+  if (g.cellStart.front() != 0 || g.cellStart.back() != g.primIds.size())
+    bad("cell offsets do not cover the references");
   for (size_t c = 0; c + 1 < g.cellStart.size(); ++c)
     if (g.cellStart[c + 1] <= g.cellStart[c] || g.cellStart[c + 1] > g.primIds.size())
       bad("cell " + std::to_string(c) + ": offsets empty, backwards or past the references");

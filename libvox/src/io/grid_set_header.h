@@ -30,7 +30,8 @@ Grid emptyGridLike(const Plan& plan) {
 // True when `name` holds a control byte (below 0x20, or DEL). Names are printed in one-line errors, which a newline
 // would split: readers refuse such names in a manifest, and the writer refuses to make them.
 inline bool hasControlByte(const std::string& name) {
-  return std::any_of(name.begin(), name.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; });
+  return std::any_of(name.begin(), name.end(),
+                     [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; });
 }
 
 // The header's checksum field of a file's bytes (0 when too short).

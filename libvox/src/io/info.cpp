@@ -82,8 +82,8 @@ Summary summarize(const InfoSource& in) {
   for (const auto& t : in.scene.triangles) s.degenerate += isDegenerate(t);
   for (const auto& sp : in.scene.spheres) s.ellipsoids += sp.isEllipsoid();
   const CellTotals& c = in.totals;
-  s.memoryBytes = c.occupied * 8 + (c.occupied + 1) * 8 + c.references * 4 + in.plan.outsidePrims.size() * 4 +
-                  c.solidRuns * 16;
+  s.memoryBytes =
+      c.occupied * 8 + (c.occupied + 1) * 8 + c.references * 4 + in.plan.outsidePrims.size() * 4 + c.solidRuns * 16;
   return s;
 }
 
@@ -107,7 +107,8 @@ void plain(std::ostream& out, const InfoSource& in) {
   }
   out << "\n";
   out << "lights: " << sc.lights.size() << "\n";
-  out << "camera: " << (sc.camera ? (sc.camera->kind == CameraKind::Perspective ? "perspective" : "orthographic") : "none") << "\n";
+  out << "camera: "
+      << (sc.camera ? (sc.camera->kind == CameraKind::Perspective ? "perspective" : "orthographic") : "none") << "\n";
   out << "occupied_cells: " << t.occupied << "\n";
   out << "solid_cells: " << t.solidCells << "\n";
   out << "references: " << t.references << "\n";
@@ -236,10 +237,9 @@ void writeGridInfo(std::ostream& out, const GridFile& file, const InfoOptions& o
 void writeGridSetInfo(std::ostream& out, const std::string& setPath, const InfoOptions& options) {
   const GridSetManifest m = readGridSetManifest(setPath);
   const GridFile sceneFile = readGridSetScene(setPath, m);
-  writeInfo(out, sceneFile.scene, sceneFile.grid, options,
-            [&](const auto& visit, bool ordered) {
-              forEachGridSetLayer(setPath, m, sceneFile, visit, ordered ? LayerCells::Sorted : LayerCells::BrickOrder);
-            });
+  writeInfo(out, sceneFile.scene, sceneFile.grid, options, [&](const auto& visit, bool ordered) {
+    forEachGridSetLayer(setPath, m, sceneFile, visit, ordered ? LayerCells::Sorted : LayerCells::BrickOrder);
+  });
 }
 
 std::string formatGridInfo(const GridFile& file, const InfoOptions& options) {

@@ -28,15 +28,17 @@ uint64_t memoryBudgetBytes() {
 void checkMemory(double bytes, const std::string& where, const std::string& what) {
   const uint64_t budget = memoryBudgetBytes();
   if (!(bytes <= double(budget)))
-    fail<LimitError>(where, ": ", what, " needs about ", std::isfinite(bytes) ? uint64_t(bytes / (1 << 20)) : UINT64_MAX,
-                     " MiB, more than the ", budget >> 20, " MiB allowed");
+    fail<LimitError>(where, ": ", what, " needs about ",
+                     std::isfinite(bytes) ? uint64_t(bytes / (1 << 20)) : UINT64_MAX, " MiB, more than the ",
+                     budget >> 20, " MiB allowed");
 }
 
 void requireRegularFile(const std::string& path, const char* what) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) fail<InputError>(path, ": cannot open ", what, ": ", std::strerror(errno));
   if (S_ISDIR(st.st_mode)) fail<InputError>(path, ": is a folder, expected the ", what);
-  if (!S_ISREG(st.st_mode)) fail<InputError>(path, ": not a regular file (a device, FIFO or socket), expected the ", what);
+  if (!S_ISREG(st.st_mode))
+    fail<InputError>(path, ": not a regular file (a device, FIFO or socket), expected the ", what);
 }
 
 std::string readInputFile(const std::string& path, const char* what) {
@@ -68,7 +70,8 @@ std::string resolveInsideFolder(const std::string& referrer, const std::string& 
   namespace fs = std::filesystem;
   const fs::path ref(reference);
   if (ref.is_absolute() || ref.has_root_name())
-    fail<InputError>(referrer, ": '", quoteInput(reference), "': absolute paths are refused (files must lie in the "
+    fail<InputError>(referrer, ": '", quoteInput(reference),
+                     "': absolute paths are refused (files must lie in the "
                      "folder of the file that names them)");
   return requireInsideFolder(referrer, (fs::absolute(referrer).parent_path() / ref).string());
 }

@@ -151,8 +151,7 @@ Accel buildAccel(const Scene& scene, const Grid& grid, AccelKind kind) {
   }
   for (uint32_t p = 0; p < accel.planeCount; ++p) accel.alwaysTested.push_back(firstPlane + p);
   std::sort(accel.alwaysTested.begin(), accel.alwaysTested.end());
-  accel.alwaysTested.erase(std::unique(accel.alwaysTested.begin(), accel.alwaysTested.end()),
-                           accel.alwaysTested.end());
+  accel.alwaysTested.erase(std::unique(accel.alwaysTested.begin(), accel.alwaysTested.end()), accel.alwaysTested.end());
 
   // The cell lookup is built for both kinds: the voxels and count modes walk the grid whatever the accel.
   for (uint32_t id : grid.primIds)

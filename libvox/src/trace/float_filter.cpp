@@ -55,7 +55,8 @@ void buildFloatCells(Accel& accel, const Grid& grid, uint64_t maxBytes) {
     uint64_t n = 0;
     for (uint64_t r = grid.cellStart[c]; r < grid.cellStart[c + 1] && grid.primIds[r] < accel.triangleCount; ++r, ++n) {
       const TriangleData& t = accel.triangles[grid.primIds[r]];
-      for (int a = 0; a < 3; ++a) m = std::max({m, std::fabs(t.v0[a] - fc.center[a]), std::fabs(t.e1[a]), std::fabs(t.e2[a])});
+      for (int a = 0; a < 3; ++a)
+        m = std::max({m, std::fabs(t.v0[a] - fc.center[a]), std::fabs(t.e1[a]), std::fabs(t.e2[a])});
     }
     groupCount += (n + 3) / 4;
   }

@@ -44,8 +44,8 @@ struct FilterRay {
   Float4 eu, ew;  // bounds on |U - U*| (and V) and |W - W*|, see above
 };
 
-inline constexpr double kU = 0x1.0p-24;        // unit roundoff of float
-inline constexpr double kUp = 1 + 0x1.0p-40;   // rounds a double bound up past the double rounding that computed it
+inline constexpr double kU = 0x1.0p-24;       // unit roundoff of float
+inline constexpr double kUp = 1 + 0x1.0p-40;  // rounds a double bound up past the double rounding that computed it
 inline constexpr double kToFloatUp = 1 + 0x1.0p-20;  // keeps a bound an upper bound through its rounding to float
 inline constexpr double kMaxOrigin = 0x1.0p40;
 

@@ -171,7 +171,8 @@ struct Renderer {
 
   // Modes whose samples are the nearest hit of the primary ray: those are traced in packets.
   bool nearestHitMode() const {
-    return options.mode == RenderMode::Shade || options.mode == RenderMode::Normals || options.mode == RenderMode::Depth;
+    return options.mode == RenderMode::Shade || options.mode == RenderMode::Normals ||
+           options.mode == RenderMode::Depth;
   }
 
   // One sample of the normals or depth mode from its hit; writes `channels` values into out.
@@ -238,73 +239,74 @@ Image traceImage(const Scene& scene, const Accel& accel, const RenderOptions& op
   image.pixels.assign(uint64_t(image.width) * image.height * image.channels, 0.0f);
 
   SampleStore store;
-  if (options.filter != FilterKind::None) store = makeSampleStore(image.width, image.height, options.samples, image.channels);
+  if (options.filter != FilterKind::None)
+    store = makeSampleStore(image.width, image.height, options.samples, image.channels);
   const uint32_t strata = uint32_t(std::lround(std::sqrt(double(options.samples))));
   const bool stratified = strata * strata == options.samples;
   tbb::combinable<TraceStats> perThread;
   std::atomic<uint64_t> rowsDone{0};
   const auto start = std::chrono::steady_clock::now();
   constexpr uint32_t kTile = 16;
-  tbb::parallel_for(
-      tbb::blocked_range2d<uint32_t>(0, image.height, kTile, 0, image.width, kTile),
-      [&](const tbb::blocked_range2d<uint32_t>& tile) {
-        TraceStats& st = perThread.local();
-        // Blocks of 8x8 pixels: each sample index of a block is one packet of primary rays.
-        constexpr uint32_t kBlock = 8;
-        static_assert(kBlock * kBlock <= kMaxPacketRays);
-        for (uint32_t by = tile.rows().begin(); by < tile.rows().end(); by += kBlock) {
-          for (uint32_t bx = tile.cols().begin(); bx < tile.cols().end(); bx += kBlock) {
-            uint32_t px[kMaxPacketRays], py[kMaxPacketRays], count = 0;
-            uint64_t rng[kMaxPacketRays];
-            for (uint32_t y = by; y < std::min(by + kBlock, tile.rows().end()); ++y)
-              for (uint32_t x = bx; x < std::min(bx + kBlock, tile.cols().end()); ++x) {
-                px[count] = x, py[count] = y;
-                rng[count++] = options.seed ^ ((uint64_t(y) << 32) | x) * 0x9e3779b97f4a7c15ull;
-              }
-            float sum[kMaxPacketRays][3] = {};
-            double jx[kMaxPacketRays], jy[kMaxPacketRays];
-            Ray rays[kMaxPacketRays];
-            Hit hits[kMaxPacketRays];
-            for (uint32_t s = 0; s < options.samples; ++s) {
-              for (uint32_t p = 0; p < count; ++p) {
-                double sx = px[p] + 0.5, sy = py[p] + 0.5;
-                if (options.samples > 1) {
-                  if (stratified) {
-                    sx = px[p] + ((s % strata) + uniform(rng[p])) / strata;
-                    sy = py[p] + ((s / strata) + uniform(rng[p])) / strata;
-                  } else {
-                    sx = px[p] + uniform(rng[p]);
-                    sy = py[p] + uniform(rng[p]);
-                  }
-                }
-                rays[p] = rayFromFrame(options.camera, r.frame, image.width, image.height, sx, sy);
-                jx[p] = sx - px[p], jy[p] = sy - py[p];
-              }
-              float value[kMaxPacketRays][3];
-              if (r.nearestHitMode()) {
-                tracePacket(accel, {rays, count}, {hits, count}, &st);
-                if (options.mode == RenderMode::Shade) r.shadePacket({rays, count}, {hits, count}, value, st);
-                else
-                  for (uint32_t p = 0; p < count; ++p) r.fromHit(rays[p], hits[p], value[p]);
-              } else {
-                for (uint32_t p = 0; p < count; ++p) r.walkSample(rays[p], value[p], st);
-              }
-              for (uint32_t p = 0; p < count; ++p)
-                for (uint32_t c = 0; c < image.channels; ++c) sum[p][c] += value[p][c];
-              if (store.active())
-                for (uint32_t p = 0; p < count; ++p) store.put(px[p], py[p], s, jx[p], jy[p], value[p]);
-            }
-            for (uint32_t p = 0; p < count; ++p) {
-              float* out = image.at(px[p], py[p]);
-              for (uint32_t c = 0; c < image.channels; ++c) out[c] = sum[p][c] / float(options.samples);
-            }
-          }
-        }
-        if (options.progress && tile.cols().end() == image.width) {
-          const uint64_t done = rowsDone.fetch_add(tile.rows().size()) + tile.rows().size();
-          options.progress(double(done) / image.height);
-        }
-      });
+  tbb::parallel_for(tbb::blocked_range2d<uint32_t>(0, image.height, kTile, 0, image.width, kTile),
+                    [&](const tbb::blocked_range2d<uint32_t>& tile) {
+                      TraceStats& st = perThread.local();
+                      // Blocks of 8x8 pixels: each sample index of a block is one packet of primary rays.
+                      constexpr uint32_t kBlock = 8;
+                      static_assert(kBlock * kBlock <= kMaxPacketRays);
+                      for (uint32_t by = tile.rows().begin(); by < tile.rows().end(); by += kBlock) {
+                        for (uint32_t bx = tile.cols().begin(); bx < tile.cols().end(); bx += kBlock) {
+                          uint32_t px[kMaxPacketRays], py[kMaxPacketRays], count = 0;
+                          uint64_t rng[kMaxPacketRays];
+                          for (uint32_t y = by; y < std::min(by + kBlock, tile.rows().end()); ++y)
+                            for (uint32_t x = bx; x < std::min(bx + kBlock, tile.cols().end()); ++x) {
+                              px[count] = x, py[count] = y;
+                              rng[count++] = options.seed ^ ((uint64_t(y) << 32) | x) * 0x9e3779b97f4a7c15ull;
+                            }
+                          float sum[kMaxPacketRays][3] = {};
+                          double jx[kMaxPacketRays], jy[kMaxPacketRays];
+                          Ray rays[kMaxPacketRays];
+                          Hit hits[kMaxPacketRays];
+                          for (uint32_t s = 0; s < options.samples; ++s) {
+                            for (uint32_t p = 0; p < count; ++p) {
+                              double sx = px[p] + 0.5, sy = py[p] + 0.5;
+                              if (options.samples > 1) {
+                                if (stratified) {
+                                  sx = px[p] + ((s % strata) + uniform(rng[p])) / strata;
+                                  sy = py[p] + ((s / strata) + uniform(rng[p])) / strata;
+                                } else {
+                                  sx = px[p] + uniform(rng[p]);
+                                  sy = py[p] + uniform(rng[p]);
+                                }
+                              }
+                              rays[p] = rayFromFrame(options.camera, r.frame, image.width, image.height, sx, sy);
+                              jx[p] = sx - px[p], jy[p] = sy - py[p];
+                            }
+                            float value[kMaxPacketRays][3];
+                            if (r.nearestHitMode()) {
+                              tracePacket(accel, {rays, count}, {hits, count}, &st);
+                              if (options.mode == RenderMode::Shade)
+                                r.shadePacket({rays, count}, {hits, count}, value, st);
+                              else
+                                for (uint32_t p = 0; p < count; ++p) r.fromHit(rays[p], hits[p], value[p]);
+                            } else {
+                              for (uint32_t p = 0; p < count; ++p) r.walkSample(rays[p], value[p], st);
+                            }
+                            for (uint32_t p = 0; p < count; ++p)
+                              for (uint32_t c = 0; c < image.channels; ++c) sum[p][c] += value[p][c];
+                            if (store.active())
+                              for (uint32_t p = 0; p < count; ++p) store.put(px[p], py[p], s, jx[p], jy[p], value[p]);
+                          }
+                          for (uint32_t p = 0; p < count; ++p) {
+                            float* out = image.at(px[p], py[p]);
+                            for (uint32_t c = 0; c < image.channels; ++c) out[c] = sum[p][c] / float(options.samples);
+                          }
+                        }
+                      }
+                      if (options.progress && tile.cols().end() == image.width) {
+                        const uint64_t done = rowsDone.fetch_add(tile.rows().size()) + tile.rows().size();
+                        options.progress(double(done) / image.height);
+                      }
+                    });
   if (store.active()) image = filterSamples(store, options.filter, options.filterRadius);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 

@@ -25,7 +25,8 @@ Surface Shader::surface(const Ray& ray, const Hit& hit) const {
   const Vec3 n = hitNormal(accel, ray, hit);
   s.backFace = dot(n, ray.direction) > 0;
   s.n = s.backFace ? -n : n;
-  const uint32_t id = std::min<uint32_t>(primitiveMaterial(scene, accel, hit.prim), uint32_t(scene.materials.size() - 1));
+  const uint32_t id =
+      std::min<uint32_t>(primitiveMaterial(scene, accel, hit.prim), uint32_t(scene.materials.size() - 1));
   s.mat = materialAt(scene, id, s.p);
   // Rays leave the surface from a hair off it, relative to the scene and to the magnitude of p.
   const double pMag = std::max({std::fabs(s.p.x), std::fabs(s.p.y), std::fabs(s.p.z)});

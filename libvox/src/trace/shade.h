@@ -53,7 +53,7 @@ struct Surface {
   Vec3 n;         // unit, dot(n, ray.direction) <= 0
   bool backFace;  // the primitive's own normal pointed along the ray
   Material mat;
-  double eps;     // offset of rays leaving the surface
+  double eps;  // offset of rays leaving the surface
 };
 
 struct Shader {

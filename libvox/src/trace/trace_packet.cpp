@@ -55,8 +55,7 @@ struct Lanes {
 
   void remove(uint32_t j) {
     const uint32_t e = --count;
-    for (double* v : {ox, oy, oz, dx, dy, dz, tMin, tMax, ok, invK, tolK, stopAt, tEnd, hitSlack})
-      v[j] = v[e];
+    for (double* v : {ox, oy, oz, dx, dy, dz, tMin, tMax, ok, invK, tolK, stopAt, tEnd, hitSlack}) v[j] = v[e];
     for (int q = 0; q < 2; ++q) a[q][j] = a[q][e], s[q][j] = s[q][e];
     ray[j] = ray[e];
   }
@@ -126,8 +125,8 @@ struct AxisBounds {
     const double lo = aLo + std::min({p0, p1, p2, p3}), hi = aHi + std::max({p0, p1, p2, p3});
     const double pad = tolPos + 64 * kEps * (magnitude + std::max(std::fabs(cA), std::fabs(cB)) * sMax);
     const double* b = cb.b[axis].data();
-    const auto r = cellRangeOnAxis(int64_t(cb.dims[axis]), cb.cellsPerUnit[axis], [b](int64_t i) { return b[i]; },
-                                   lo - pad, hi + pad);
+    const auto r = cellRangeOnAxis(
+        int64_t(cb.dims[axis]), cb.cellsPerUnit[axis], [b](int64_t i) { return b[i]; }, lo - pad, hi + pad);
     return {r[0], r[1], 0};
   }
 
@@ -267,8 +266,8 @@ void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<H
       const int u = other[q];
       lanes.s[q][l] = slope[q];
       lanes.a[q][l] = at[q];
-      bounds[q].magnitude = std::max(bounds[q].magnitude, std::fabs(at[q]) + std::fabs(ray.origin[u]) +
-                                                              std::fabs(shift) * std::fabs(slope[q]));
+      bounds[q].magnitude = std::max(
+          bounds[q].magnitude, std::fabs(at[q]) + std::fabs(ray.origin[u]) + std::fabs(shift) * std::fabs(slope[q]));
       bounds[q].sMax = std::max(bounds[q].sMax, std::fabs(slope[q]));
       originMax[u] = std::max(originMax[u], std::fabs(ray.origin[u]));
     }
@@ -279,7 +278,8 @@ void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<H
   }
   // Slices to walk, in order of travel: from `first` to `last`.
   const double padK = positionTolerance(cb, k, originMax[k]);
-  const auto range = cellRangeOnAxis(nk, cb.cellsPerUnit[k], [bk](int64_t i) { return bk[i]; }, pLo - padK, pHi + padK);
+  const auto range = cellRangeOnAxis(
+      nk, cb.cellsPerUnit[k], [bk](int64_t i) { return bk[i]; }, pLo - padK, pHi + padK);
   if (range[0] > range[1]) lanes.count = 0;
   if (lanes.count == 0) {
     for (uint32_t r = 0; r < n; ++r) hits[r] = best[r];

@@ -218,8 +218,8 @@ inline void consider(const Accel& accel, uint32_t id, const Ray& ray, Hit& best,
 // the nearest hit in `best`. An occlusion query (AnyHit) returns at its first hit; the return value says whether it
 // hit.
 template <bool AnyHit>
-inline bool testRefs(const Accel& accel, uint64_t begin, uint64_t end, const Ray& ray, Mailbox<64>& mailbox,
-                     Hit& best, TraceStats& st) {
+inline bool testRefs(const Accel& accel, uint64_t begin, uint64_t end, const Ray& ray, Mailbox<64>& mailbox, Hit& best,
+                     TraceStats& st) {
   for (uint64_t r = begin; r < end; ++r) {
     const uint32_t id = accel.grid->primIds[r];
     if (mailbox.seen(id)) {
@@ -298,7 +298,8 @@ inline bool walkCells(const Accel& accel, const Ray& ray, Hit& best, TraceStats&
     ++st.cells;
     bool hit = false;
     if (direct) {
-      hit = testGroups<AnyHit>(accel, accel.floatCell(cell.idx[0], cell.idx[1], cell.idx[2]), ray, *fr, mailbox, best, st);
+      hit = testGroups<AnyHit>(accel, accel.floatCell(cell.idx[0], cell.idx[1], cell.idx[2]), ray, *fr, mailbox, best,
+                               st);
     } else {
       const uint32_t c = accel.lookup(cell.idx[0], cell.idx[1], cell.idx[2]);
       if (c < kSolidCell) hit = testCell<AnyHit>(accel, c, ray, fr, mailbox, best, st);
@@ -323,7 +324,8 @@ inline bool walkCells(const Accel& accel, const Ray& ray, Hit& best, TraceStats&
                                                                          TraceStats& st) {
   walkCells<false>(accel, ray, best, st);
 }
-[[gnu::target_clones("avx2", "default"), gnu::flatten]] bool walkAny(const Accel& accel, const Ray& ray, TraceStats& st) {
+[[gnu::target_clones("avx2", "default"), gnu::flatten]] bool walkAny(const Accel& accel, const Ray& ray,
+                                                                     TraceStats& st) {
   Hit any;
   return walkCells<true>(accel, ray, any, st);
 }

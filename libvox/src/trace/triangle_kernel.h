@@ -18,8 +18,8 @@ typedef double Double4 __attribute__((vector_size(32)));
 // Returns whether the ray meets the triangle at a t in [tMin, tMax] (a bool for double, a lane mask for Double4);
 // `t` is written either way for Double4, and for double whenever the ray meets the closed triangle.
 template <typename T>
-[[gnu::always_inline]] inline auto triangleHit(const double* v0, const double* e1, const double* e2, const double* n, T ox, T oy, T oz,
-                        T dx, T dy, T dz, T tMin, T tMax, T& t) {
+[[gnu::always_inline]] inline auto triangleHit(const double* v0, const double* e1, const double* e2, const double* n,
+                                               T ox, T oy, T oz, T dx, T dy, T dz, T tMin, T tMax, T& t) {
   const T det = -(dx * n[0] + dy * n[1] + dz * n[2]);
   const T sx = ox - v0[0], sy = oy - v0[1], sz = oz - v0[2];
   const T cx = sy * dz - sz * dy, cy = sz * dx - sx * dz, cz = sx * dy - sy * dx;

@@ -21,8 +21,8 @@ uint32_t brickOfCell(uint64_t c, uint64_t n, uint64_t B) { return uint32_t(((c +
 void checkBrickCounts(const std::array<uint32_t, 3>& dims, const std::array<uint32_t, 3>& bricks) {
   for (int a = 0; a < 3; ++a)
     if (bricks[a] == 0 || bricks[a] > dims[a])
-      fail<UsageError>("--bricks: ", bricks[a], " bricks on axis ", "xyz"[a], " of a grid ", dims[0], "x", dims[1],
-                       "x", dims[2], " (each brick needs at least one cell: 1 to ", dims[a], ")");
+      fail<UsageError>("--bricks: ", bricks[a], " bricks on axis ", "xyz"[a], " of a grid ", dims[0], "x", dims[1], "x",
+                       dims[2], " (each brick needs at least one cell: 1 to ", dims[a], ")");
   if (uint64_t(bricks[0]) * bricks[1] * bricks[2] > kMaxBricks)
     fail<UsageError>("--bricks: ", bricks[0], "x", bricks[1], "x", bricks[2], " bricks, more than the ", kMaxBricks,
                      " allowed");
@@ -88,8 +88,10 @@ std::vector<std::vector<uint32_t>> brickCandidates(const Scene& scene, const Gri
 }
 
 void appendSolidRun(std::vector<CellRun>& runs, const CellRun& run) {
-  if (!runs.empty() && runs.back().first + runs.back().count == run.first) runs.back().count += run.count;
-  else runs.push_back(run);
+  if (!runs.empty() && runs.back().first + runs.back().count == run.first)
+    runs.back().count += run.count;
+  else
+    runs.push_back(run);
 }
 
 std::vector<std::pair<uint64_t, std::vector<CellRun>>> splitRunsByBrick(std::span<const CellRun> runs,

@@ -24,7 +24,10 @@ std::array<int64_t, 2> cellRangeOnAxis(int64_t n, double scale, const BoundaryFn
     int64_t a = 0, z = n - 1;  // smallest c in [0, n-1] with !below(c), or n-1
     while (a < z) {
       const int64_t mid = a + (z - a) / 2;
-      if (below(mid)) a = mid + 1; else z = mid;
+      if (below(mid))
+        a = mid + 1;
+      else
+        z = mid;
     }
     return a;
   };

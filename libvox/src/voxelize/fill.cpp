@@ -46,8 +46,10 @@ struct UnionFind {
   }
   void unite(uint64_t a, uint64_t b) {
     a = find(a), b = find(b);
-    if (a < b) parent[b] = a;
-    else if (b < a) parent[a] = b;
+    if (a < b)
+      parent[b] = a;
+    else if (b < a)
+      parent[a] = b;
   }
 };
 
@@ -65,8 +67,10 @@ RowTable buildRows(const Grid& grid, uint64_t memoryLimitBytes) {
   const auto& keys = grid.cellKeys;
   uint64_t rows = 0, gaps = 0;  // counted first so that the budget is checked before allocating
   for (size_t c = 0; c < keys.size(); ++c) {
-    if (c == 0 || keys[c] / nx != keys[c - 1] / nx) ++rows;
-    else if (keys[c] > keys[c - 1] + 1) ++gaps;
+    if (c == 0 || keys[c] / nx != keys[c - 1] / nx)
+      ++rows;
+    else if (keys[c] > keys[c - 1] + 1)
+      ++gaps;
   }
   const double needed = kBytesPerRow * double(rows) + kBytesPerGap * double(gaps);
   if (needed > double(memoryLimitBytes))
@@ -115,13 +119,17 @@ template <typename Label>
 void linkRows(const std::vector<Interval>& a, const std::vector<Interval>& b, UnionFind& uf, const Label& label) {
   size_t p = 0, q = 0;
   while (p < a.size() && q < b.size()) {
-    if (a[p].hi < b[q].lo) ++p;
-    else if (b[q].hi < a[p].lo) ++q;
+    if (a[p].hi < b[q].lo)
+      ++p;
+    else if (b[q].hi < a[p].lo)
+      ++q;
     else {
       const int64_t la = label(a[p]), lb = label(b[q]);
       if (la >= 0 && lb >= 0) uf.unite(uint64_t(la), uint64_t(lb));
-      if (a[p].hi < b[q].hi) ++p;
-      else ++q;
+      if (a[p].hi < b[q].hi)
+        ++p;
+      else
+        ++q;
     }
   }
 }
@@ -321,9 +329,12 @@ struct HoleCaps {
         }
         bool pos = false, neg = false, unsure = false;
         for (int i = 0; i < 3; ++i) {
-          if (e[i] > err[i]) pos = true;
-          else if (e[i] < -err[i]) neg = true;
-          else unsure = true;
+          if (e[i] > err[i])
+            pos = true;
+          else if (e[i] < -err[i])
+            neg = true;
+          else
+            unsure = true;
         }
         if (pos && neg) continue;  // the line misses this triangle
         if (unsure) return false;
@@ -504,14 +515,13 @@ std::pair<uint64_t, uint64_t> decideRuns(const Grid& grid, const Scene& scene, s
         state[run.slot] = kDecided;
       } else {
         state[run.slot] = caps->bound(box) <= HoleCaps::kByIntegerAlone ? kByInteger
-                          : caps->meets(box)                             ? kCrossed
-                                                                         : kByCaps;
+                          : caps->meets(box)                            ? kCrossed
+                                                                        : kByCaps;
       }
     }
   });
   if (!winding || !caps->enabled) return {sweep.full, sweep.caps};
-  const UnionFind groups =
-      linkRuns(t, grid, [&](const Interval& run) { return sharesK(state[run.slot]); });
+  const UnionFind groups = linkRuns(t, grid, [&](const Interval& run) { return sharesK(state[run.slot]); });
   const std::vector<int64_t> k = groupIntegers(grid, t, *w, *caps, groups, state, sweep);
   // Pass 2: the waiting runs, by k alone, by k - s, or by w itself when k could not be told.
   sweep([&](size_t r, const Interval& run, uint64_t* counts) {
@@ -571,9 +581,8 @@ FillReport fillSolid(Grid& grid, const Scene& scene, const FillOptions& options)
     return report;
   }
   std::vector<Piece> pieces(table.gaps.size() + 2 * table.row.size());
-  std::tie(report.windingQueries, report.capQueries) =
-      decideRuns(grid, scene, std::move(boundaries), table, enclosed, report.rule == FillRule::WindingNumber, options,
-                 pieces);
+  std::tie(report.windingQueries, report.capQueries) = decideRuns(
+      grid, scene, std::move(boundaries), table, enclosed, report.rule == FillRule::WindingNumber, options, pieces);
   grid.solidRuns.clear();
   // Reserved once: growing a vector of millions of runs costs more in page faults than the loop itself.
   grid.solidRuns.reserve(uint64_t(std::count_if(pieces.begin(), pieces.end(), [](Piece p) { return p.lo <= p.hi; })));
@@ -620,8 +629,7 @@ std::string fillWarning(const FillReport& r) {
   // likely means an inside-out or wrapping surface.
   if (r.rule == FillRule::WindingNumber && r.emptyCells > 0 && r.solidCells == r.emptyCells)
     return "every empty cell of the grid is solid (by winding number): is the grid inside the surface?";
-  if (r.emptyCells > 0 && r.solidCells == 0)
-    return "no empty cell is inside a surface: nothing filled";
+  if (r.emptyCells > 0 && r.solidCells == 0) return "no empty cell is inside a surface: nothing filled";
   return "";
 }
 

@@ -27,18 +27,15 @@ K::Iso_cuboid_3 toCuboid(const Box& b) { return {toPoint(b.lo), toPoint(b.hi)}; 
 
 }  // namespace
 
-bool isDegenerate(const Triangle& t) {
-  return CGAL::collinear(toPoint(t.v[0]), toPoint(t.v[1]), toPoint(t.v[2]));
-}
+bool isDegenerate(const Triangle& t) { return CGAL::collinear(toPoint(t.v[0]), toPoint(t.v[1]), toPoint(t.v[2])); }
 
 bool triangleBoxExact(const Triangle& t, const Box& box) {
   const Point p[3] = {toPoint(t.v[0]), toPoint(t.v[1]), toPoint(t.v[2])};
   const K::Iso_cuboid_3 cuboid = toCuboid(box);
   if (!CGAL::collinear(p[0], p[1], p[2])) return CGAL::do_intersect(K::Triangle_3(p[0], p[1], p[2]), cuboid);
   // Collinear: the triangle is the segment between its lexicographically smallest and largest vertex.
-  const auto [lo, hi] = std::minmax({p[0], p[1], p[2]}, [](const Point& a, const Point& b) {
-    return CGAL::compare_xyz(a, b) == CGAL::SMALLER;
-  });
+  const auto [lo, hi] = std::minmax(
+      {p[0], p[1], p[2]}, [](const Point& a, const Point& b) { return CGAL::compare_xyz(a, b) == CGAL::SMALLER; });
   if (lo == hi) return !cuboid.has_on_unbounded_side(lo);
   return CGAL::do_intersect(K::Segment_3(lo, hi), cuboid);
 }

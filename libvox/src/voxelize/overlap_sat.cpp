@@ -18,5 +18,4 @@ bool triangleBoxSat(const Triangle& t, const Box& box) {
   return filter.test(box) != FilterResult::Disjoint;
 }
 
-
 }  // namespace vox

@@ -126,8 +126,7 @@ bool sphereSurfaceMeetsBox(const Sphere& s, const Box& box) {
         y[1] = (A[0][0] * b[1] - b[0] * A[1][0]) / d;
       } else {
         auto det3 = [](const NT M[3][3]) {
-          return M[0][0] * (M[1][1] * M[2][2] - M[1][2] * M[2][1]) -
-                 M[0][1] * (M[1][0] * M[2][2] - M[1][2] * M[2][0]) +
+          return M[0][0] * (M[1][1] * M[2][2] - M[1][2] * M[2][1]) - M[0][1] * (M[1][0] * M[2][2] - M[1][2] * M[2][0]) +
                  M[0][2] * (M[1][0] * M[2][1] - M[1][1] * M[2][0]);
         };
         const NT d = det3(A);

@@ -23,20 +23,20 @@ enum class FilterResult { Disjoint, Overlap, Unknown };
 
 // Plain arrays rather than Vec3 so that the fixed-size loops below unroll into straight-line code.
 struct TriangleFilter {
-  double origin[3];            // v0
-  double edges[3][3];          // v1 - v0, v2 - v1, v0 - v2
-  double normal[3];            // (v1 - v0) x (v2 - v0)
-  double normalErr[3];         // error bound of each normal component
-  double triMin[3], triMax[3]; // exact bounding box of the vertices
-  double edgeProj[3][3][2];    // [edge][axis] -> min, max of the triangle's projection
-  double edgeProjErr[3][3];    // error bound of those projections
+  double origin[3];             // v0
+  double edges[3][3];           // v1 - v0, v2 - v1, v0 - v2
+  double normal[3];             // (v1 - v0) x (v2 - v0)
+  double normalErr[3];          // error bound of each normal component
+  double triMin[3], triMax[3];  // exact bounding box of the vertices
+  double edgeProj[3][3][2];     // [edge][axis] -> min, max of the triangle's projection
+  double edgeProjErr[3][3];     // error bound of those projections
   // Which side of edge i's line (on the axis edges[i] x unit_a) the triangle lies: +1 above, -1 below, 0 unknown
   // (degenerate or too close to call). Schwarz and Seidel (2010): the triangle meets the box iff the box meets its
   // plane and, in each of the three axis projections, the box's bounding square and the 2D triangle overlap; in
   // 2D it suffices to check that the box is not entirely on the outer side of each edge. So an edge axis needs
   // testing on one side only, halving the work, whenever the side is certain.
   int edgeSide[3][3];
-  bool usable = true;          // false: magnitudes outside the filter's range
+  bool usable = true;  // false: magnitudes outside the filter's range
 
   static constexpr double kU = DBL_EPSILON / 2;
   static constexpr double kTiny = 1e-300;
@@ -93,8 +93,8 @@ struct TriangleFilter {
   // them once per triangle keeps the per-cell test to a few multiply-adds per axis.
   double boxErr[3][3];  // [edge][axis]: total error bound of the comparison on that edge axis
   double normalBoxErr;
-  int normalSel[3];     // per axis: 0 when the normal's box minimum uses the cell's low side, 1 for the high side
-  int edgeSel[3][3][2]; // [edge][axis][b or c]: likewise for the edge axes' minimum
+  int normalSel[3];      // per axis: 0 when the normal's box minimum uses the cell's low side, 1 for the high side
+  int edgeSel[3][3][2];  // [edge][axis][b or c]: likewise for the edge axes' minimum
 
   void prepare(const double qMax[3]) {
     for (int i = 0; i < 3; ++i)

@@ -47,7 +47,8 @@ void alignUpperBounds(Grid& grid) {
       grid.bounds.hi.at(a) = std::nextafter(grid.bounds.hi[a], HUGE_VAL);
       if (++steps > 4096)
         fail<E>("bounds [", grid.bounds.lo[a], ", ", grid.bounds.hi[a], "] on axis ", "xyz"[a],
-                " cannot be divided into ", grid.dims[a], " cells in double precision (coordinates of very "
+                " cannot be divided into ", grid.dims[a],
+                " cells in double precision (coordinates of very "
                 "different magnitudes?)");
     }
   }
@@ -191,8 +192,7 @@ std::array<uint32_t, 3> dimsForResolution(const Box& bounds, uint32_t resolution
   // Extents relative to the largest, so that bounds of subnormal width cannot underflow the cell size to 0.
   const Vec3 e = relativeExtents(bounds);
   std::array<uint32_t, 3> dims;
-  for (int a = 0; a < 3; ++a)
-    dims[a] = uint32_t(std::clamp<double>(std::round(e[a] * resolution), 1, resolution));
+  for (int a = 0; a < 3; ++a) dims[a] = uint32_t(std::clamp<double>(std::round(e[a] * resolution), 1, resolution));
   return dims;
 }
 
@@ -201,8 +201,7 @@ std::array<uint32_t, 3> defaultDims(const Box& bounds, size_t boundedPrimitives)
   const double target = std::max(1.0, kCellsPerPrimitive * double(boundedPrimitives));
   const double cell = std::cbrt(e.x * e.y * e.z / target);
   std::array<uint32_t, 3> dims;
-  for (int a = 0; a < 3; ++a)
-    dims[a] = uint32_t(std::clamp<double>(std::round(e[a] / cell), 1, 1024));
+  for (int a = 0; a < 3; ++a) dims[a] = uint32_t(std::clamp<double>(std::round(e[a] / cell), 1, 1024));
   return dims;
 }
 
@@ -289,8 +288,8 @@ struct Local {
 
 // Gathers the references of all threads into grid's compressed cell lists, grouped by cell in key order with ids
 // ascending; returns the summed counters (seconds not set).
-VoxelizeStats gatherReferences(tbb::enumerable_thread_specific<Local>& locals, bool packed, int primBits,
-                               int keyBits, Grid& grid) {
+VoxelizeStats gatherReferences(tbb::enumerable_thread_specific<Local>& locals, bool packed, int primBits, int keyBits,
+                               Grid& grid) {
   const uint64_t primMask = (uint64_t(1) << primBits) - 1;
   VoxelizeStats local{};
   size_t total = 0;
@@ -424,7 +423,7 @@ void voxelizeWindow(const Scene& scene, Grid& grid, const CellWindow& window, co
           for (int64_t i = first[0]; i <= last[0]; ++i) {
             bool fallback = false;
             const bool hit = options.method == OverlapMethod::Sat ? sphereBoxSat(s, box(i, j, k))
-                                                                   : sphereBoxFiltered(s, box(i, j, k), &fallback);
+                                                                  : sphereBoxFiltered(s, box(i, j, k), &fallback);
             local.fallbacks += fallback;
             if (hit) emit(i, j, k);
           }
@@ -451,8 +450,8 @@ void voxelizeWindow(const Scene& scene, Grid& grid, const CellWindow& window, co
       for (idx[b] = first[b]; idx[b] <= last[b]; ++idx[b]) {
         int64_t from = first[a], to = last[a];
         if (sweep.usable) {
-          const auto [lo, hi] = sweep.range(boundary[b][idx[b]], boundary[b][idx[b] + 1], boundary[c][idx[c]],
-                                            boundary[c][idx[c] + 1]);
+          const auto [lo, hi] =
+              sweep.range(boundary[b][idx[b]], boundary[b][idx[b] + 1], boundary[c][idx[c]], boundary[c][idx[c] + 1]);
           const auto& table = boundary[a];
           const auto r = cellRangeOnAxis(
               int64_t(dims[a]), boundaryScale[a], [&](int64_t i) { return table[size_t(i)]; }, lo, hi);

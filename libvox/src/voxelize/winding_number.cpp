@@ -69,8 +69,10 @@ void buildNode(WindingTree& tree, const BuildInput& in, std::vector<uint32_t>& o
                    [&](uint32_t a, uint32_t b) { return in.centroid[a][axis] < in.centroid[b][axis]; });
   auto left = [&] { buildNode(tree, in, order, first, half, index + 1); };
   auto right = [&] { buildNode(tree, in, order, first + half, count - half, index + 1 + subtreeNodes(half)); };
-  if (count < 4096) left(), right();
-  else tbb::parallel_invoke(left, right);
+  if (count < 4096)
+    left(), right();
+  else
+    tbb::parallel_invoke(left, right);
 }
 
 }  // namespace

@@ -39,7 +39,7 @@ template <typename E = InputError, typename... Parts>
 }  // namespace vox
 
 // Programmer errors: always checked, print both sides.
-#define VOX_CHECK(cond)                                                                             \
-  do {                                                                                              \
+#define VOX_CHECK(cond)                                                                            \
+  do {                                                                                             \
     if (!(cond)) ::vox::fail<std::logic_error>(__FILE__, ":", __LINE__, ": check failed: " #cond); \
   } while (0)

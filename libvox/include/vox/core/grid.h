@@ -81,6 +81,7 @@ void checkSolidRuns(const std::vector<CellRun>& runs, uint64_t cellCount, const 
 // Smallest index range [first, last] of cells on `axis` whose closed boxes meet [lo, hi] (clamped to the grid);
 // uses cellBoundary, so a coordinate exactly on a boundary yields both neighbouring cells. first > last when the
 // interval misses the grid.
-std::array<int64_t, 2> cellRange(const Box& bounds, const std::array<uint32_t, 3>& dims, int axis, double lo, double hi);
+std::array<int64_t, 2> cellRange(const Box& bounds, const std::array<uint32_t, 3>& dims, int axis, double lo,
+                                 double hi);
 
 }  // namespace vox

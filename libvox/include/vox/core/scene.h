@@ -76,15 +76,15 @@ struct Light {
 };
 
 struct Scene {
-  std::vector<Material> materials;  // never empty after import: importers add a default white material
+  std::vector<Material> materials;          // never empty after import: importers add a default white material
   std::vector<SolidTexture> solidTextures;  // referenced by Material::solidTexture
   std::vector<Triangle> triangles;
   std::vector<Sphere> spheres;
   std::vector<Plane> planes;
   std::vector<Texture> textures;                     // referenced by Material::diffuseTexture
   std::vector<std::array<TexCoord, 3>> triangleUVs;  // empty (no texture coordinates), or one per triangle
-  std::optional<Camera> camera;      // none: tools frame the bounds (defaultCamera)
-  std::vector<Light> lights;         // empty: tools add a headlight
+  std::optional<Camera> camera;                      // none: tools frame the bounds (defaultCamera)
+  std::vector<Light> lights;                         // empty: tools add a headlight
   Vec3 background{0.5, 0.5, 0.5};
   Vec3 ambient{0, 0, 0};
   std::vector<std::string> warnings;  // importer remarks for the tools to print (the library never prints)

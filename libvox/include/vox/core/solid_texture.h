@@ -26,9 +26,9 @@ inline constexpr uint32_t kMaxOctaves = 32;
 
 struct SolidTexture {
   SolidKind kind = SolidKind::Checkerboard;
-  Mat4 transform;                  // world point -> texture space
-  uint32_t materials[2] = {0, 0};  // indices into Scene::materials
-  uint32_t octaves = 0;            // Noise, Marble, Wood
+  Mat4 transform;                       // world point -> texture space
+  uint32_t materials[2] = {0, 0};       // indices into Scene::materials
+  uint32_t octaves = 0;                 // Noise, Marble, Wood
   double frequency = 1, amplitude = 1;  // Marble, Wood
 };
 

@@ -18,10 +18,10 @@ namespace vox {
 
 // How a grid maps onto the binvox cube.
 struct BinvoxLayout {
-  uint32_t dim = 1;     // D = max(nx, ny, nz): the grid sits in the corner x < nx, y < ny, z < nz, the rest empty
-  Vec3 translate;       // world position of the cube's corner: the grid's bounds.lo
-  double scale = 1;     // world side of the whole cube: D times the voxel side
-  double voxelSide = 1; // the cell side of the grid's axis with the most cells (ties: x, then y), the one --res sets
+  uint32_t dim = 1;      // D = max(nx, ny, nz): the grid sits in the corner x < nx, y < ny, z < nz, the rest empty
+  Vec3 translate;        // world position of the cube's corner: the grid's bounds.lo
+  double scale = 1;      // world side of the whole cube: D times the voxel side
+  double voxelSide = 1;  // the cell side of the grid's axis with the most cells (ties: x, then y), the one --res sets
   // How far the grid's cells are from cubes: max over axes of n_a * |cell_a - voxelSide| / voxelSide, the shift of
   // the grid's far face, in voxels, when its cells are written as cubes of voxelSide. 0 for cubic cells.
   double farFaceShiftVoxels = 0;

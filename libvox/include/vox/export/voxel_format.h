@@ -22,13 +22,13 @@ std::optional<VoxelFormat> voxelFormatFromPath(const std::string& path);
 
 // What was written, for the tool's --stats and warnings.
 struct VoxelFileReport {
-  uint64_t voxels = 0;          // occupied and solid cells written
-  uint64_t models = 0;          // .vox: models (256^3 tiles); .vdb: leaf nodes of `density`
-  uint32_t gridColors = 0;      // .vox: distinct voxel colours
-  uint32_t paletteColors = 0;   // .vox: palette size
-  bool paletteReduced = false;  // .vox: more than 255 colours, reduced by median cut
-  double binvoxShiftVoxels = 0; // .binvox: how far non-cubic cells move the grid's far face (BinvoxLayout)
-  double binvoxVoxelSide = 0;   // .binvox: the cube side written
+  uint64_t voxels = 0;           // occupied and solid cells written
+  uint64_t models = 0;           // .vox: models (256^3 tiles); .vdb: leaf nodes of `density`
+  uint32_t gridColors = 0;       // .vox: distinct voxel colours
+  uint32_t paletteColors = 0;    // .vox: palette size
+  bool paletteReduced = false;   // .vox: more than 255 colours, reduced by median cut
+  double binvoxShiftVoxels = 0;  // .binvox: how far non-cubic cells move the grid's far face (BinvoxLayout)
+  double binvoxVoxelSide = 0;    // .binvox: the cube side written
 };
 
 // Writes the voxels of `grid` to `path` in `format` (binvox_writer.h, magicavoxel_writer.h, vdb_writer.h).

@@ -144,7 +144,8 @@ inline bool intersectPrimitive(const Accel& accel, uint32_t id, const Ray& ray, 
 // The same test for the primitive at position `ref` of grid->primIds (id == grid->primIds[ref]), reading a triangle
 // from Accel::cellTriangles when there is one: the same TriangleData, so the same result and t.
 inline bool intersectCellPrimitive(const Accel& accel, uint64_t ref, uint32_t id, const Ray& ray, double& t) {
-  if (id < accel.triangleCount && !accel.cellTriangles.empty()) return intersectTriangle(accel.cellTriangles[ref], ray, t);
+  if (id < accel.triangleCount && !accel.cellTriangles.empty())
+    return intersectTriangle(accel.cellTriangles[ref], ray, t);
   return intersectPrimitive(accel, id, ray, t);
 }
 

@@ -31,8 +31,6 @@ struct Hit {
 
 // The order in which hits are preferred: nearer first, then smaller id. Used by every path so that grid and brute
 // force traversal pick the same hit.
-inline bool closer(double t, uint32_t prim, const Hit& best) {
-  return t < best.t || (t == best.t && prim < best.prim);
-}
+inline bool closer(double t, uint32_t prim, const Hit& best) { return t < best.t || (t == best.t && prim < best.prim); }
 
 }  // namespace vox

@@ -38,7 +38,7 @@ inline constexpr double kMaxFilterRadius = 16;
 struct RenderOptions {
   uint32_t width = 512, height = 512;
   RenderMode mode = RenderMode::Shade;
-  uint32_t samples = 1;   // per pixel; > 1 jitters inside the pixel (stratified when a square number)
+  uint32_t samples = 1;  // per pixel; > 1 jitters inside the pixel (stratified when a square number)
   // Shade mode, the course's recursive ray tracing (docs/trace.md "Shading"): reflected and refracted rays up to
   // `bounces` deep, a path stopped when its weight (product of the reflective or transparent colours' largest
   // component along it) falls under `weight`; back faces black unless `shadeBack`; shadow rays unless !shadows.
@@ -48,16 +48,16 @@ struct RenderOptions {
   bool shadows = true;
   FilterKind filter = FilterKind::None;  // None: each pixel is the plain mean of its own samples
   double filterRadius = 0.5;             // pixels
-  Camera camera;          // already resolved (scene camera, overrides or defaultCamera)
-  uint64_t seed = 0;      // of the per-pixel jitter
+  Camera camera;                         // already resolved (scene camera, overrides or defaultCamera)
+  uint64_t seed = 0;                     // of the per-pixel jitter
   // Called from worker threads with the fraction of rows done; may be empty.
   std::function<void(double)> progress;
 };
 
 struct RenderStats {
-  TraceStats trace;       // every ray: primary, shadow
+  TraceStats trace;  // every ray: primary, shadow
   double traceSeconds = 0;
-  double countMax = 0;    // count mode: cells visited of the busiest pixel (the top of the heat map)
+  double countMax = 0;                // count mode: cells visited of the busiest pixel (the top of the heat map)
   double depthMin = 0, depthMax = 0;  // depth mode: range over hit pixels (0, 0 when nothing is hit)
 };
 

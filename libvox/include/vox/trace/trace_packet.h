@@ -24,6 +24,7 @@ void tracePacket(const Accel& accel, std::span<const Ray> rays, std::span<Hit> h
 
 // occluded[i] = occluded(accel, rays[i]) (shadow rays), under the same conditions: equal to the brute force on exact,
 // sat and bbox grids, may differ from occluded() on a `center` grid.
-void occludedPacket(const Accel& accel, std::span<const Ray> rays, std::span<bool> occluded, TraceStats* stats = nullptr);
+void occludedPacket(const Accel& accel, std::span<const Ray> rays, std::span<bool> occluded,
+                    TraceStats* stats = nullptr);
 
 }  // namespace vox

@@ -35,7 +35,8 @@ inline constexpr double kCellSlack = 1e-6;
 // Positional tolerance on axis a, in world units, for coordinates up to `coord` in magnitude: a fraction of a cell
 // plus the rounding of coordinates that large (the grid's own included).
 inline double positionTolerance(const CellBoundaries& cells, int a, double coord) {
-  return kCellSlack * cells.cellSize[a] + 64 * std::numeric_limits<double>::epsilon() * (std::fabs(coord) + cells.magnitude[a]);
+  return kCellSlack * cells.cellSize[a] +
+         64 * std::numeric_limits<double>::epsilon() * (std::fabs(coord) + cells.magnitude[a]);
 }
 // Bound on the error of a primitive hit's position, world units, for a ray from `origin`; divided by a direction
 // component no larger than the largest it is a bound in ray parameter units (RayAxes::hitSlack).
@@ -50,11 +51,11 @@ inline double hitSlackAt(double hitSlack, double t) { return hitSlack + 1e-9 * s
 
 // The per-axis constants of one ray's walk.
 struct RayAxes {
-  double inv[3];      // 1 / d
-  bool divide[3];     // 1 / d is not a normal number: divide by d instead of multiplying by inv
-  double tolPos[3];   // positional tolerance of each axis in world units
-  double tol[3];      // the same in ray parameter units (0 for a zero component)
-  double hitSlack;    // bound on the error of a primitive hit's t, without the part relative to t
+  double inv[3];     // 1 / d
+  bool divide[3];    // 1 / d is not a normal number: divide by d instead of multiplying by inv
+  double tolPos[3];  // positional tolerance of each axis in world units
+  double tol[3];     // the same in ray parameter units (0 for a zero component)
+  double hitSlack;   // bound on the error of a primitive hit's t, without the part relative to t
 
   // The parameter at which the ray crosses the plane x_a = b: (b - o) * (1 / d) when 1 / d is a normal number (a
   // multiplication instead of a division per step; error at most 2 ulps more than the quotient, far inside kWalkRel),
@@ -139,7 +140,6 @@ class GridWalker {
   // Bound on the error of a primitive hit's t at parameter t (ray units), used to decide when the walk may stop.
   double hitSlack(double t) const { return ax_.hitSlackAt(t); }
   uint64_t stepsTaken() const { return steps_; }
-
 
  private:
   static constexpr double kRel = kWalkRel;
@@ -240,10 +240,10 @@ bool occluded(const Accel& accel, const Ray& ray, TraceStats* stats = nullptr);
 // The first occupied (or solid) cell along the ray, for the voxels mode. Independent of accel.kind.
 struct CellHit {
   bool hit = false;
-  double t = 0;                       // ray parameter where the cell is entered (ray.tMin when the ray starts in it)
+  double t = 0;  // ray parameter where the cell is entered (ray.tMin when the ray starts in it)
   std::array<uint32_t, 3> idx{0, 0, 0};
-  int entryAxis = -1;                 // as in WalkCell
-  uint32_t primCount = 0;             // 0 for a solid cell
+  int entryAxis = -1;      // as in WalkCell
+  uint32_t primCount = 0;  // 0 for a solid cell
   bool solid = false;
 };
 CellHit firstOccupiedCell(const Accel& accel, const Ray& ray, TraceStats* stats = nullptr);

@@ -41,14 +41,14 @@ struct FillOptions {
 
 struct FillReport {
   FillRule rule = FillRule::Enclosed;
-  uint64_t openEdges = 0;        // countOpenEdges of the scene's triangles
-  bool leakyMethod = false;      // the grid's method is `center`, whose surfaces have gaps
-  uint64_t enclosedCells = 0;    // solid because enclosed (both rules)
-  uint64_t windingCells = 0;     // solid because of the winding number (WindingNumber rule only)
-  uint64_t windingQueries = 0;   // winding numbers of the scene evaluated
-  uint64_t capQueries = 0;       // winding numbers of the holes' caps alone evaluated (fill.cpp, HoleCaps)
-  uint64_t solidCells = 0;       // enclosedCells + windingCells == grid.solidCount()
-  uint64_t emptyCells = 0;       // cells holding no primitive
+  uint64_t openEdges = 0;       // countOpenEdges of the scene's triangles
+  bool leakyMethod = false;     // the grid's method is `center`, whose surfaces have gaps
+  uint64_t enclosedCells = 0;   // solid because enclosed (both rules)
+  uint64_t windingCells = 0;    // solid because of the winding number (WindingNumber rule only)
+  uint64_t windingQueries = 0;  // winding numbers of the scene evaluated
+  uint64_t capQueries = 0;      // winding numbers of the holes' caps alone evaluated (fill.cpp, HoleCaps)
+  uint64_t solidCells = 0;      // enclosedCells + windingCells == grid.solidCount()
+  uint64_t emptyCells = 0;      // cells holding no primitive
 };
 
 // Sets grid.solidRuns (replacing what it held) from `scene`, the scene `grid` was voxelized from. Works on runs of

@@ -14,20 +14,20 @@
 namespace vox {
 
 struct VoxelizeOptions {
-  std::optional<Box> bounds;                     // user bounds; default: scene bounds, zero-width axes padded
-  std::optional<std::array<uint32_t, 3>> dims;   // --grid
-  std::optional<uint32_t> resolution;            // --res: cells on the longest axis
+  std::optional<Box> bounds;                    // user bounds; default: scene bounds, zero-width axes padded
+  std::optional<std::array<uint32_t, 3>> dims;  // --grid
+  std::optional<uint32_t> resolution;           // --res: cells on the longest axis
   OverlapMethod method = OverlapMethod::Exact;
-  uint64_t memoryLimitBytes = 16ull << 30;       // refuse requests whose estimate exceeds this, before allocating
+  uint64_t memoryLimitBytes = 16ull << 30;  // refuse requests whose estimate exceeds this, before allocating
   // Called with a fraction in [0, 1] from worker threads; return false to cancel (throws vox::Error).
   std::function<bool(double)> progress;
 };
 
 struct VoxelizeStats {
-  uint64_t cellsTested = 0;      // primitive-cell overlap tests evaluated
-  uint64_t exactFallbacks = 0;   // tests that the floating-point filter could not decide (exact method)
+  uint64_t cellsTested = 0;     // primitive-cell overlap tests evaluated
+  uint64_t exactFallbacks = 0;  // tests that the floating-point filter could not decide (exact method)
   uint64_t degenerateTriangles = 0;
-  double seconds = 0;            // time in voxelization alone
+  double seconds = 0;  // time in voxelization alone
 };
 
 inline constexpr uint32_t kMaxCellsPerAxis = 1u << 21;  // keeps every cell key below 2^63

@@ -28,10 +28,10 @@ double windingNumberExact(std::span<const Triangle> triangles, const Vec3& q);
 // is the index just past its subtree), triangles reordered so that each node owns a contiguous range.
 struct WindingTree {
   struct Node {
-    Vec3 center;           // area-weighted centroid of the node's triangles: the expansion point
-    double radius = 0;     // largest distance from center to a vertex of the node's triangles
-    Vec3 normalSum;        // sum of area-weighted normals (order 1 term)
-    double moment[9] = {};  // sum of area * normal (x) (centroid - center), row-major (order 2 term)
+    Vec3 center;                    // area-weighted centroid of the node's triangles: the expansion point
+    double radius = 0;              // largest distance from center to a vertex of the node's triangles
+    Vec3 normalSum;                 // sum of area-weighted normals (order 1 term)
+    double moment[9] = {};          // sum of area * normal (x) (centroid - center), row-major (order 2 term)
     uint32_t first = 0, count = 0;  // triangle range in `corners`
     uint32_t skip = 0;              // next node after this subtree; a leaf is skip == own index + 1
   };

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages libvox needs, idempotently: nothing is fetched when all are present.
-# Usage: scripts/install-deps.sh [--bench] [--meshlab] [--clients] [--fuzz]
+# Usage: scripts/install-deps.sh [--bench] [--meshlab] [--clients] [--fuzz] [--format]
 set -euo pipefail
 packages=(build-essential cmake ninja-build pkg-config python3
   libcgal-dev libopenmesh-dev libopenimageio-dev libtinygltf-dev libstb-dev nlohmann-json3-dev
@@ -15,6 +15,7 @@ for arg in "$@"; do
     # python3-openvdb (pyopenvdb) reads exported .vdb files back (tests/cli/export_voxel_formats.sh).
     --clients) packages+=(meshlab xvfb xauth assimp-utils blender python3-numpy python3-openvdb) ;;
     --fuzz) packages+=(clang libclang-rt-14-dev) ;;  # libFuzzer and the sanitizer runtimes (scripts/fuzz.sh)
+    --format) packages+=(clang-format git) ;;  # scripts/check-format.sh
     *) echo "install-deps.sh: unknown option $arg" >&2; exit 1 ;;
   esac
 done

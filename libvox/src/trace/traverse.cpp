@@ -319,16 +319,21 @@ inline bool walkCells(const Accel& accel, const Ray& ray, Hit& best, TraceStats&
 // load time like the packet kernel; `flatten` puts the walker, the filter and the setup into each copy. The
 // arithmetic is IEEE either way: no FMA is enabled (the "avx2" target does not imply it, and -ffp-contract=off forbids
 // contraction), so both copies visit the same cells and get the same t. intersect.cpp's tests are called out of line,
-// the same code for both.
-[[gnu::target_clones("avx2", "default"), gnu::flatten]] void walkNearest(const Accel& accel, const Ray& ray, Hit& best,
-                                                                         TraceStats& st) {
+// the same code for both. clang refuses `flatten` on a multiversioned function (its fuzz build gets the clones
+// with their usual inlining).
+#if defined(__clang__)
+#define VOX_WALK_COPIES [[gnu::target_clones("avx2", "default")]]
+#else
+#define VOX_WALK_COPIES [[gnu::target_clones("avx2", "default"), gnu::flatten]]
+#endif
+VOX_WALK_COPIES void walkNearest(const Accel& accel, const Ray& ray, Hit& best, TraceStats& st) {
   walkCells<false>(accel, ray, best, st);
 }
-[[gnu::target_clones("avx2", "default"), gnu::flatten]] bool walkAny(const Accel& accel, const Ray& ray,
-                                                                     TraceStats& st) {
+VOX_WALK_COPIES bool walkAny(const Accel& accel, const Ray& ray, TraceStats& st) {
   Hit any;
   return walkCells<true>(accel, ray, any, st);
 }
+#undef VOX_WALK_COPIES
 
 }  // namespace
 

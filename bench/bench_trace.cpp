@@ -107,6 +107,16 @@ struct EmbreeScene {
 };
 
 // The rays in the order vox-trace makes them: 8x8 pixel tiles, tile after tile (pixel[i] is the pixel of ray i).
+// One Embree ray from ours, converted to float (in every timed loop, as each method converts its own rays).
+RTCRayHit embreeRayHit(const vox::Ray& ray, float tnear, float tfar) {
+  RTCRayHit rh{};
+  rh.ray.org_x = float(ray.origin.x), rh.ray.org_y = float(ray.origin.y), rh.ray.org_z = float(ray.origin.z);
+  rh.ray.dir_x = float(ray.direction.x), rh.ray.dir_y = float(ray.direction.y), rh.ray.dir_z = float(ray.direction.z);
+  rh.ray.tnear = tnear, rh.ray.tfar = tfar, rh.ray.mask = unsigned(-1);
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  return rh;
+}
+
 struct TiledRays {
   std::vector<vox::Ray> rays;
   std::vector<uint64_t> pixel;
@@ -171,12 +181,7 @@ void benchPrimary(const std::string& path, unsigned threads, uint32_t size, int 
            rtcInitIntersectContext(&ctx);
            for (uint64_t i = r.begin(); i < r.end(); ++i) {
              const vox::Ray& ray = tiled.rays[i];
-             RTCRayHit rh{};
-             rh.ray.org_x = float(ray.origin.x), rh.ray.org_y = float(ray.origin.y), rh.ray.org_z = float(ray.origin.z);
-             rh.ray.dir_x = float(ray.direction.x), rh.ray.dir_y = float(ray.direction.y),
-             rh.ray.dir_z = float(ray.direction.z);
-             rh.ray.tnear = 0, rh.ray.tfar = INFINITY, rh.ray.mask = unsigned(-1);
-             rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+             RTCRayHit rh = embreeRayHit(ray, 0, INFINITY);
              rtcIntersect1(es, &ctx, &rh);
              embreeHit[tiled.pixel[i]] = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? vox::kNoPrim : rh.hit.primID;
            }
@@ -349,12 +354,7 @@ void embreeTrace(RTCScene es, const RaySet& set, std::vector<EmbreeResult>& out)
     rtcInitIntersectContext(&ctx);
     for (size_t i = r.begin(); i < r.end(); ++i) {
       const vox::Ray& ray = set.rays[i];
-      RTCRayHit rh{};
-      rh.ray.org_x = float(ray.origin.x), rh.ray.org_y = float(ray.origin.y), rh.ray.org_z = float(ray.origin.z);
-      rh.ray.dir_x = float(ray.direction.x), rh.ray.dir_y = float(ray.direction.y),
-      rh.ray.dir_z = float(ray.direction.z);
-      rh.ray.tnear = float(ray.tMin), rh.ray.tfar = float(ray.tMax), rh.ray.mask = unsigned(-1);
-      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      RTCRayHit rh = embreeRayHit(ray, float(ray.tMin), float(ray.tMax));
       if (set.occlusion) {
         rtcOccluded1(es, &ctx, &rh.ray);
         out[i] = {rh.ray.tfar < 0 ? 0.0f : INFINITY, vox::kNoPrim};

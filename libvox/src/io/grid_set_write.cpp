@@ -90,41 +90,78 @@ BrickEntry writeBrick(const std::string& setPath, const GridSetManifest& set, co
   return writeBrickFile(setPath, set, index, grid);
 }
 
+namespace {
+
+// Calls visit(keys, k0, k1) for consecutive slabs of whole planes of a layer of bricks, each holding at most
+// `slabCells` of its sorted `keys` unless one plane holds more.
+template <typename Visit>
+void forEachSlab(const GridSetManifest& set, uint32_t bz, std::span<const uint64_t> keys, uint64_t slabCells,
+                 const Visit& visit) {
+  const CellWindow layer = brickWindow(set.dims, set.bricks, {0, 0, bz});
+  const uint64_t plane = uint64_t(set.dims[0]) * set.dims[1];
+  auto planeStart = [&](uint64_t k) { return std::lower_bound(keys.begin(), keys.end(), k * plane); };
+  for (uint32_t k0 = layer.first[2]; k0 < layer.end[2];) {
+    const auto from = planeStart(k0);
+    uint32_t k1 = k0 + 1;
+    while (k1 < layer.end[2] && uint64_t(planeStart(k1 + 1) - from) <= slabCells) ++k1;
+    visit(std::span<const uint64_t>(from, planeStart(k1)), k0, k1);
+    k0 = k1;
+  }
+}
+
+}  // namespace
+
 FillReport fillGridSet(const std::string& setPath, GridSetManifest& set, const Scene& scene,
                        const FillOptions& options) {
-  // The occupied cells of the whole grid, keys only: all that fillSolid reads of a grid besides its plan.
-  Grid keys = emptyGridLike(set);
-  uint64_t occupied = 0;
-  for (const BrickEntry& e : set.entries) occupied += e.occupied;
-  if (double(occupied) * 8 > double(options.memoryLimitBytes))
-    fail<LimitError>("solid fill of a grid set of ", occupied, " occupied cells needs their keys, ", occupied >> 17,
-                     " MiB, more than the ", options.memoryLimitBytes >> 20, " MiB allowed");
-  keys.cellKeys.reserve(occupied);
-  for (size_t i = 0; i < set.entries.size(); ++i) {
-    const Grid brick = readBrick(setPath, set, i, scene.boundedCount());
-    keys.cellKeys.insert(keys.cellKeys.end(), brick.cellKeys.begin(), brick.cellKeys.end());
-  }
-  std::sort(keys.cellKeys.begin(), keys.cellKeys.end());
-  // The same keys, plan and scene as the single grid: fillSolid decides every run exactly as it does there.
-  const FillReport report = fillSolid(keys, scene, options);
-  std::vector<uint64_t>().swap(keys.cellKeys);
-  auto split = splitRunsByBrick(keys.solidRuns, set.dims, set.bricks);
-  std::vector<CellRun>().swap(keys.solidRuns);
-  // Bricks holding solid cells are rewritten with them (or written, when they hold no occupied cell).
+  const uint64_t boundedCount = scene.boundedCount();
+  SlabFill fill(emptyGridLike(set), scene, options);
+  uint32_t bz = 0;  // forEachGridSetLayer visits every layer, in ascending bz
+  forEachGridSetLayer(
+      setPath, set, boundedCount,
+      [&](const Grid& layer) {
+        forEachSlab(set, bz++, layer.cellKeys, options.slabCells,
+                    [&](std::span<const uint64_t> keys, uint32_t k0, uint32_t k1) { fill.link(keys, k0, k1); });
+      },
+      LayerCells::KeysOnly);
+  // The second reading decides each layer's runs; bricks holding solid cells are rewritten with them (or written,
+  // when they hold no occupied cell) once their layer is read.
+  std::vector<BrickEntry> written;
+  bz = 0;
+  forEachGridSetLayer(
+      setPath, set, boundedCount,
+      [&](const Grid& layer) {
+        std::vector<CellRun> runs;
+        forEachSlab(set, bz++, layer.cellKeys, options.slabCells,
+                    [&](std::span<const uint64_t> keys, uint32_t k0, uint32_t k1) {
+                      for (const CellRun& run : fill.fill(keys, k0, k1)) appendSolidRun(runs, run);
+                    });
+        for (auto& [number, brickRuns] : splitRunsByBrick(runs, set.dims, set.bricks)) {
+          const auto e = std::lower_bound(
+              set.entries.begin(), set.entries.end(), number,
+              [&](const BrickEntry& entry, uint64_t n) { return brickNumber(set.bricks, entry.index) < n; });
+          Grid cells = emptyGridLike(set);
+          if (e != set.entries.end() && brickNumber(set.bricks, e->index) == number)
+            cells = readBrick(setPath, set, size_t(e - set.entries.begin()), boundedCount);
+          cells.solidRuns = std::move(brickRuns);
+          written.push_back(writeBrickFile(setPath, set, brickIndex(set.bricks, number), cells));
+        }
+      },
+      LayerCells::KeysOnly);
+  // Entries rewritten replace the old ones; both lists are ascending by brick number.
   std::vector<BrickEntry> entries;
-  size_t e = 0;
-  for (auto& [number, runs] : split) {
-    while (e < set.entries.size() && brickNumber(set.bricks, set.entries[e].index) < number)
-      entries.push_back(set.entries[e++]);
-    Grid cells = emptyGridLike(set);
-    if (e < set.entries.size() && brickNumber(set.bricks, set.entries[e].index) == number)
-      cells = readBrick(setPath, set, e++, scene.boundedCount());
-    cells.solidRuns = std::move(runs);
-    entries.push_back(writeBrickFile(setPath, set, brickIndex(set.bricks, number), cells));
+  entries.reserve(set.entries.size() + written.size());
+  auto number = [&](const BrickEntry& e) { return brickNumber(set.bricks, e.index); };
+  size_t w = 0;
+  for (const BrickEntry& e : set.entries) {
+    while (w < written.size() && number(written[w]) < number(e)) entries.push_back(written[w++]);
+    if (w < written.size() && number(written[w]) == number(e))
+      entries.push_back(written[w++]);
+    else
+      entries.push_back(e);
   }
-  entries.insert(entries.end(), set.entries.begin() + ptrdiff_t(e), set.entries.end());
+  entries.insert(entries.end(), written.begin() + ptrdiff_t(w), written.end());
   set.entries = std::move(entries);
-  return report;
+  return fill.report();
 }
 
 void writeGridSetManifest(const std::string& setPath, const GridSetManifest& manifest) {

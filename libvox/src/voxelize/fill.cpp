@@ -10,6 +10,7 @@
 #include <optional>
 #include <sstream>
 #include <tuple>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -161,10 +162,17 @@ UnionFind linkRuns(const RowTable& t, const Grid& grid, const Keep& keep) {
   return uf;
 }
 
+// The planes a table covers, and whether its lowest and highest planes continue into other slabs (SlabFill): the
+// links across those faces are the other slabs', so they are neither made nor taken as the outside.
+struct PlaneRange {
+  uint64_t low = 0, high = 0;
+  bool continuesBelow = false, continuesAbove = false;
+};
+
 // 6-connected components of the empty cells, over runs: a gap is enclosed when its component does not reach
 // the outside. Each pair of listed neighbouring rows is swept once, from the lower row; a neighbour that is not
 // listed (or lies outside the grid) is all empty and outside.
-UnionFind linkGaps(const RowTable& t, const Grid& grid) {
+UnionFind linkGaps(const RowTable& t, const Grid& grid, const PlaneRange& planes = {}) {
   UnionFind uf;
   uf.parent.resize(t.gaps.size() + 1);
   for (uint64_t n = 0; n < uf.parent.size(); ++n) uf.parent[n] = n;
@@ -177,6 +185,8 @@ UnionFind linkGaps(const RowTable& t, const Grid& grid) {
     const bool hasGaps = t.gapBegin[r + 1] > t.gapBegin[r];
     bool loaded = false;
     for (int o = 0; o < 4; ++o) {
+      if ((o == 0 && planes.continuesBelow && k == planes.low) || (o == 3 && planes.continuesAbove && k == planes.high))
+        continue;
       const bool inGrid = o == 0 ? k > 0 : o == 1 ? j > 0 : o == 2 ? j + 1 < ny : k + 1 < nz;
       if (!inGrid) {
         for (uint64_t g = t.gapBegin[r]; g < t.gapBegin[r + 1]; ++g) uf.unite(0, g + 1);
@@ -378,28 +388,33 @@ constexpr int64_t kUnknown = std::numeric_limits<int64_t>::min();  // a group wh
 // Whether a slot's run waits for its group's k (it meets no cap).
 bool sharesK(uint8_t state) { return state == kByInteger || state == kByCaps; }
 
-// Runs each listed row's empty runs through `body(r, run, counts)` in parallel, with progress and cancellation.
+// Runs the empty runs of each listed row from `firstRow` on through `body(r, run, counts)` in parallel, with
+// progress and cancellation.
 struct RowSweep {
   const RowTable& t;
   const Grid& grid;
   const FillOptions& options;
+  size_t firstRow = 0;
   std::atomic<uint64_t> done{0}, full{0}, caps{0};
   std::atomic<bool> cancelled{false};
 
   template <typename Body>
   void operator()(const Body& body) {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, t.row.size(), 64), [&](const tbb::blocked_range<size_t>& range) {
-      if (cancelled) return;
-      std::vector<Interval> runs;
-      uint64_t counts[2] = {0, 0};  // full and cap evaluations
-      for (size_t r = range.begin(); r < range.end(); ++r) {
-        rowIntervals(t, grid, r, runs);
-        for (const Interval& run : runs) body(r, run, counts);
-      }
-      full += counts[0], caps += counts[1];
-      const uint64_t finished = done += range.size();
-      if (options.progress && !options.progress(double(finished) / double(2 * t.row.size()))) cancelled = true;
-    });
+    const size_t rows = t.row.size() - firstRow;
+    tbb::parallel_for(tbb::blocked_range<size_t>(firstRow, t.row.size(), 64),
+                      [&](const tbb::blocked_range<size_t>& range) {
+                        if (cancelled) return;
+                        std::vector<Interval> runs;
+                        uint64_t counts[2] = {0, 0};  // full and cap evaluations
+                        for (size_t r = range.begin(); r < range.end(); ++r) {
+                          rowIntervals(t, grid, r, runs);
+                          for (const Interval& run : runs) body(r, run, counts);
+                        }
+                        full += counts[0], caps += counts[1];
+                        const uint64_t finished = done += range.size();
+                        if (options.progress && !options.progress(double(finished) / double(2 * rows)))
+                          cancelled = true;
+                      });
     if (cancelled) fail<Error>("solid fill cancelled");
   }
 };
@@ -461,15 +476,16 @@ int64_t neighbourK(const Grid& grid, const RowTable& t, const HoleCaps& caps, co
 
 // The solid part of every empty run of the listed rows: enclosed gaps whole; under the WindingNumber rule the other
 // runs by their group's k (HoleCaps), by k minus the caps' winding number, or, where a cap crosses the run, by the
-// winding number itself. Returns the evaluations of the mesh's winding number and of the caps'.
+// winding number itself. Rows before `firstRow` (a SlabFill's plane below the slab) are left undecided and serve
+// no neighbour. Returns the evaluations of the mesh's winding number and of the caps'.
 std::pair<uint64_t, uint64_t> decideRuns(const Grid& grid, const Scene& scene, std::vector<OpenBoundary>&& boundaries,
                                          const RowTable& t, const std::vector<uint8_t>& enclosed, bool winding,
-                                         const FillOptions& options, std::vector<Piece>& pieces) {
+                                         const FillOptions& options, size_t firstRow, std::vector<Piece>& pieces) {
   std::optional<SceneWinding> w;
   std::optional<HoleCaps> caps;
   if (winding) w.emplace(scene), caps.emplace(std::move(boundaries), grid.method == OverlapMethod::Center);
   std::vector<uint8_t> state(pieces.size(), kNone);
-  RowSweep sweep{t, grid, options};
+  RowSweep sweep{t, grid, options, firstRow};
   const uint64_t nx = grid.dims[0];
   auto byWinding = [&](size_t r, const Interval& run, uint64_t* counts) {
     return decideRun(run.lo, run.hi, [&](uint32_t x) {
@@ -544,11 +560,10 @@ std::pair<uint64_t, uint64_t> decideRuns(const Grid& grid, const Scene& scene, s
   });
   return {sweep.full, sweep.caps};
 }
-}  // namespace
-
-FillReport fillSolid(Grid& grid, const Scene& scene, const FillOptions& options) {
+// The report's rule and the holes' boundaries, from the scene alone; LimitError when the winding tree would not fit.
+FillReport startFill(const Grid& grid, const Scene& scene, const FillOptions& options,
+                     std::vector<OpenBoundary>& boundaries) {
   FillReport report;
-  report.emptyCells = grid.cellCount() - grid.occupiedCount();
   report.leakyMethod = grid.method == OverlapMethod::Center;
   // The tree and its build, the edge weld, and the holes' caps (up to three triangles per triangle).
   const double treeBytes = 640.0 * double(scene.triangles.size());
@@ -556,55 +571,207 @@ FillReport fillSolid(Grid& grid, const Scene& scene, const FillOptions& options)
     fail<LimitError>("solid fill of ", scene.triangles.size(), " triangles needs about ",
                      uint64_t(treeBytes / (1 << 20)), " MiB of scratch memory, more than the ",
                      options.memoryLimitBytes >> 20, " MiB allowed");
-  std::vector<OpenBoundary> boundaries = openBoundaries(scene.triangles, &report.openEdges, HoleCaps::kMaxBoundaries);
+  boundaries = openBoundaries(scene.triangles, &report.openEdges, HoleCaps::kMaxBoundaries);
   report.rule = report.openEdges > 0 || report.leakyMethod ? FillRule::WindingNumber : FillRule::Enclosed;
   if (options.rule) report.rule = *options.rule;
+  return report;
+}
 
-  const RowTable table = buildRows(grid, options.memoryLimitBytes);
-  std::vector<uint8_t> enclosed(table.gaps.size(), 0);
-  {
-    UnionFind uf = linkGaps(table, grid);
-    const uint64_t outside = uf.find(0);
-    for (uint64_t g = 0; g < table.gaps.size(); ++g) enclosed[g] = uf.find(g + 1) != outside;
-  }
-  grid.solidRuns.clear();
+// Per gap: whether its component (the root `uf` gives it) is enclosed; `outsideRoot(root)` says it is not.
+template <typename IsOutside>
+std::vector<uint8_t> enclosedGaps(const RowTable& t, UnionFind& uf, const IsOutside& outsideRoot) {
+  std::vector<uint8_t> enclosed(t.gaps.size(), 0);
+  for (uint64_t g = 0; g < t.gaps.size(); ++g) enclosed[g] = !outsideRoot(uf.find(g + 1));
+  return enclosed;
+}
+
+// The solid runs of the table's rows from `firstRow` on, sorted and merged where they touch, under report.rule;
+// adds their counts to `report`.
+std::vector<CellRun> solidRuns(const Grid& grid, const Scene& scene, std::vector<OpenBoundary>&& boundaries,
+                               const RowTable& t, const std::vector<uint8_t>& enclosed, size_t firstRow,
+                               const FillOptions& options, FillReport& report) {
+  std::vector<CellRun> runs;
+  uint64_t enclosedCells = 0;
+  for (uint64_t g = t.gapBegin[firstRow]; g < t.gaps.size(); ++g)
+    if (enclosed[g]) enclosedCells += t.gaps[g].count;
   if (report.rule == FillRule::Enclosed) {
     // The enclosed gaps are the runs, already sorted and never adjacent (occupied cells or a row end between
     // them): no per-run scratch needed.
-    for (uint64_t g = 0; g < table.gaps.size(); ++g)
-      if (enclosed[g]) {
-        grid.solidRuns.push_back(table.gaps[g]);
-        report.solidCells += table.gaps[g].count;
-      }
-    report.enclosedCells = report.solidCells;
-    if (options.progress) options.progress(1.0);
-    return report;
+    for (uint64_t g = t.gapBegin[firstRow]; g < t.gaps.size(); ++g)
+      if (enclosed[g]) runs.push_back(t.gaps[g]);
+    report.solidCells += enclosedCells;
+    report.enclosedCells += enclosedCells;
+    return runs;
   }
-  std::vector<Piece> pieces(table.gaps.size() + 2 * table.row.size());
-  std::tie(report.windingQueries, report.capQueries) = decideRuns(
-      grid, scene, std::move(boundaries), table, enclosed, report.rule == FillRule::WindingNumber, options, pieces);
-  grid.solidRuns.clear();
+  std::vector<Piece> pieces(t.gaps.size() + 2 * t.row.size());
+  const auto [full, caps] = decideRuns(grid, scene, std::move(boundaries), t, enclosed,
+                                       report.rule == FillRule::WindingNumber, options, firstRow, pieces);
+  report.windingQueries += full;
+  report.capQueries += caps;
   // Reserved once: growing a vector of millions of runs costs more in page faults than the loop itself.
-  grid.solidRuns.reserve(uint64_t(std::count_if(pieces.begin(), pieces.end(), [](Piece p) { return p.lo <= p.hi; })));
-  for (size_t r = 0; r < table.row.size(); ++r) {
-    const uint64_t base = table.row[r] * grid.dims[0];
-    for (uint64_t s = firstSlot(table, r); s < firstSlot(table, r + 1); ++s) {
+  const uint64_t firstPiece = firstSlot(t, firstRow);
+  runs.reserve(uint64_t(
+      std::count_if(pieces.begin() + ptrdiff_t(firstPiece), pieces.end(), [](Piece p) { return p.lo <= p.hi; })));
+  uint64_t solid = 0;
+  for (size_t r = firstRow; r < t.row.size(); ++r) {
+    const uint64_t base = t.row[r] * grid.dims[0];
+    for (uint64_t s = firstSlot(t, r); s < firstSlot(t, r + 1); ++s) {
       const Piece p = pieces[s];
       if (p.lo > p.hi) continue;
       const uint64_t first = base + p.lo, count = uint64_t(p.hi) - p.lo + 1;
-      report.solidCells += count;
+      solid += count;
       // A row's last run and the next row's first can touch: runs must stay non-adjacent.
-      if (!grid.solidRuns.empty() && grid.solidRuns.back().first + grid.solidRuns.back().count == first)
-        grid.solidRuns.back().count += count;
+      if (!runs.empty() && runs.back().first + runs.back().count == first)
+        runs.back().count += count;
       else
-        grid.solidRuns.push_back({first, count});
+        runs.push_back({first, count});
     }
   }
-  for (uint64_t g = 0; g < table.gaps.size(); ++g)
-    if (enclosed[g] && !options.windingOnly) report.enclosedCells += table.gaps[g].count;
-  report.windingCells = report.solidCells - report.enclosedCells;
+  if (options.windingOnly) enclosedCells = 0;
+  report.solidCells += solid;
+  report.enclosedCells += enclosedCells;
+  report.windingCells += solid - enclosedCells;
+  return runs;
+}
+
+// A slab's cells as a grid (the plane below the slab, then the slab's own), its rows and its flood components.
+struct SlabLinks {
+  Grid grid;
+  RowTable table;
+  UnionFind uf;
+  size_t firstRow = 0;       // the first row of the slab's own planes
+  uint64_t firstTopGap = 0;  // the first gap of its top plane
+};
+
+SlabLinks linkSlab(Grid&& grid, uint32_t k0, uint32_t k1, uint64_t memoryLimitBytes) {
+  SlabLinks s{std::move(grid), {}, {}, 0, 0};
+  const uint64_t ny = s.grid.dims[1], nz = s.grid.dims[2];
+  s.table = buildRows(s.grid, memoryLimitBytes);
+  s.uf = linkGaps(s.table, s.grid, PlaneRange{k0 > 0 ? k0 - 1u : 0u, k1 - 1u, k0 > 0, k1 < nz});
+  const auto rowAt = [&](uint64_t plane) {
+    return size_t(std::lower_bound(s.table.row.begin(), s.table.row.end(), plane * ny) - s.table.row.begin());
+  };
+  s.firstRow = rowAt(k0);
+  s.firstTopGap = s.table.gapBegin[rowAt(k1 - 1u)];
+  return s;
+}
+}  // namespace
+
+FillReport fillSolid(Grid& grid, const Scene& scene, const FillOptions& options) {
+  std::vector<OpenBoundary> boundaries;
+  FillReport report = startFill(grid, scene, options, boundaries);
+  report.emptyCells = grid.cellCount() - grid.occupiedCount();
+  const RowTable table = buildRows(grid, options.memoryLimitBytes);
+  std::vector<uint8_t> enclosed;
+  {
+    UnionFind uf = linkGaps(table, grid);
+    const uint64_t outside = uf.find(0);
+    enclosed = enclosedGaps(table, uf, [&](uint64_t root) { return root == outside; });
+  }
+  grid.solidRuns = solidRuns(grid, scene, std::move(boundaries), table, enclosed, 0, options, report);
   if (options.progress) options.progress(1.0);
   return report;
+}
+
+SlabFill::SlabFill(const Grid& plan, const Scene& scene, const FillOptions& options)
+    : scene_(scene), options_(options) {
+  plan_.bounds = plan.bounds;
+  plan_.dims = plan.dims;
+  plan_.method = plan.method;
+  report_ = startFill(plan_, scene, options, boundaries_);
+}
+
+Grid SlabFill::slabGrid(std::span<const uint64_t> keys, uint32_t k0, uint32_t k1) {
+  const uint64_t plane = uint64_t(plan_.dims[0]) * plan_.dims[1];
+  if (k0 != nextPlane_ || k1 <= k0 || k1 > plan_.dims[2])
+    fail<Error>("solid fill: slab of planes [", k0, ", ", k1, ") out of order (next plane ", nextPlane_, ")");
+  if (!keys.empty() && (keys.front() < k0 * plane || keys.back() >= k1 * plane))
+    fail<Error>("solid fill: a cell of the slab of planes [", k0, ", ", k1, ") lies outside it");
+  Grid g = plan_;
+  g.cellKeys.reserve(previousPlane_.size() + keys.size());
+  g.cellKeys = previousPlane_;
+  g.cellKeys.insert(g.cellKeys.end(), keys.begin(), keys.end());
+  // The slab's top plane is the next slab's plane below.
+  previousPlane_.assign(std::lower_bound(keys.begin(), keys.end(), (k1 - 1u) * plane), keys.end());
+  nextPlane_ = k1;
+  return g;
+}
+
+FillOptions SlabFill::slabOptions(uint32_t k0, uint32_t k1, bool secondPass) const {
+  FillOptions o = options_;
+  if (!options_.progress) return o;
+  const double nz = plan_.dims[2], from = (secondPass ? nz : 0) + k0, width = k1 - k0;
+  o.progress = [progress = options_.progress, from, width, nz](double f) {
+    return progress((from + f * width) / (2 * nz));
+  };
+  return o;
+}
+
+void SlabFill::link(std::span<const uint64_t> keys, uint32_t k0, uint32_t k1) {
+  if (filling_) fail<Error>("solid fill: a slab linked after the fill began");
+  SlabLinks s = linkSlab(slabGrid(keys, k0, k1), k0, k1, options_.memoryLimitBytes);
+  const std::vector<uint64_t> none, &below = slab_ > 0 ? topLabels_[slab_ - 1] : none;
+  if (s.table.gapBegin[s.firstRow] != below.size())
+    fail<Error>("solid fill: the plane below slab [", k0, ", ", k1, ") is not the one linked before");
+  UnionFind labels{std::move(labelParent_)};
+  const uint64_t outside = s.uf.find(0);
+  std::unordered_map<uint64_t, uint64_t> labelOf;  // component root -> its label
+  for (uint64_t g = 0; g < below.size(); ++g) {
+    const uint64_t root = s.uf.find(g + 1);
+    if (root == outside)
+      labels.unite(0, below[g]);
+    else if (const auto [it, fresh] = labelOf.try_emplace(root, below[g]); !fresh)
+      labels.unite(it->second, below[g]);
+  }
+  std::vector<uint64_t> top;
+  if (k1 < plan_.dims[2]) {
+    top.reserve(s.table.gaps.size() - s.firstTopGap);
+    for (uint64_t g = s.firstTopGap; g < s.table.gaps.size(); ++g) {
+      const uint64_t root = s.uf.find(g + 1);
+      if (root == outside) {
+        top.push_back(0);
+        continue;
+      }
+      const auto [it, fresh] = labelOf.try_emplace(root, labels.parent.size());
+      if (fresh) labels.parent.push_back(it->second);
+      top.push_back(it->second);
+    }
+  }
+  labelParent_ = std::move(labels.parent);
+  topLabels_.push_back(std::move(top));
+  ++slab_;
+  if (options_.progress && !slabOptions(k0, k1, false).progress(1.0)) fail<Error>("solid fill cancelled");
+}
+
+std::vector<CellRun> SlabFill::fill(std::span<const uint64_t> keys, uint32_t k0, uint32_t k1) {
+  if (!filling_) {
+    if (nextPlane_ != plan_.dims[2]) fail<Error>("solid fill: the fill began before every plane was linked");
+    filling_ = true, slab_ = 0, nextPlane_ = 0;
+    previousPlane_.clear();
+    UnionFind labels{std::move(labelParent_)};
+    for (uint64_t n = 0; n < labels.parent.size(); ++n) labels.find(n);  // compressed: a label's root is its parent
+    labelParent_ = std::move(labels.parent);
+  }
+  if (slab_ >= topLabels_.size()) fail<Error>("solid fill: more slabs filled than linked");
+  SlabLinks s = linkSlab(slabGrid(keys, k0, k1), k0, k1, options_.memoryLimitBytes);
+  const std::vector<uint64_t> none, &below = slab_ > 0 ? topLabels_[slab_ - 1] : none, &top = topLabels_[slab_];
+  const uint64_t outside = s.uf.find(0);
+  // A component is outside when it reaches the outside within the slab or through a labelled gap of a face plane.
+  std::unordered_map<uint64_t, bool> outsideThroughLabel;
+  for (uint64_t g = 0; g < below.size(); ++g) outsideThroughLabel[s.uf.find(g + 1)] = labelParent_[below[g]] == 0;
+  for (uint64_t g = 0; g < top.size(); ++g)
+    outsideThroughLabel[s.uf.find(s.firstTopGap + g + 1)] = labelParent_[top[g]] == 0;
+  const std::vector<uint8_t> enclosed = enclosedGaps(s.table, s.uf, [&](uint64_t root) {
+    if (root == outside) return true;
+    const auto it = outsideThroughLabel.find(root);
+    return it != outsideThroughLabel.end() && it->second;
+  });
+  report_.emptyCells += (k1 - k0) * uint64_t(plan_.dims[0]) * plan_.dims[1] - keys.size();
+  std::vector<CellRun> runs = solidRuns(s.grid, scene_, std::vector<OpenBoundary>(boundaries_), s.table, enclosed,
+                                        s.firstRow, slabOptions(k0, k1, true), report_);
+  ++slab_;
+  if (options_.progress && !slabOptions(k0, k1, true).progress(1.0)) fail<Error>("solid fill cancelled");
+  return runs;
 }
 
 std::string describeFill(const FillReport& r) {

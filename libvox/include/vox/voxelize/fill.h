@@ -4,10 +4,13 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "vox/core/grid.h"
 #include "vox/core/scene.h"
+#include "vox/voxelize/open_edges.h"
 
 namespace vox {
 
@@ -37,6 +40,9 @@ struct FillOptions {
   // WindingNumber rule decides the enclosed runs by winding number too.
   std::optional<FillRule> rule;
   bool windingOnly = false;
+  // Grid sets (fillGridSet): occupied cells per slab of whole z planes (a plane is never split), which bounds the
+  // fill's scratch memory to about one slab's.
+  uint64_t slabCells = uint64_t(1) << 22;
 };
 
 struct FillReport {
@@ -57,6 +63,40 @@ struct FillReport {
 // spread over the TBB arena of the caller. Throws LimitError when the scratch memory exceeds options.memoryLimitBytes,
 // vox::Error when cancelled. Precondition: grid.cellKeys sorted (as voxelizeScene makes them).
 FillReport fillSolid(Grid& grid, const Scene& scene, const FillOptions& options = {});
+
+// fillSolid over a grid given as slabs of whole z planes, for grids whose occupied cells do not fit in memory at once
+// (grid sets). The flood's components are joined across slab faces through labels given to the gaps of each slab's
+// top plane: pass 1 (`link`, every slab in ascending z) joins them, pass 2 (`fill`, the same slabs again, in the same
+// order) decides each slab's runs with the components' final status. Scratch memory is one slab's (fillSolid's for
+// its cells) plus one plane's keys and 8 bytes per gap of every slab's top plane. The solid runs, concatenated and
+// merged where they touch (appendSolidRun), are fillSolid's for the whole grid, run for run.
+class SlabFill {
+ public:
+  // `plan`: bounds, dims and method of the grid (its cells are ignored). Throws LimitError as fillSolid.
+  SlabFill(const Grid& plan, const Scene& scene, const FillOptions& options);
+  // `keys`: the occupied cells of planes [k0, k1), sorted; k0 is 0 or the previous slab's k1.
+  void link(std::span<const uint64_t> keys, uint32_t k0, uint32_t k1);
+  // After every plane was linked: the solid runs of planes [k0, k1), sorted. Throws as fillSolid.
+  std::vector<CellRun> fill(std::span<const uint64_t> keys, uint32_t k0, uint32_t k1);
+  // The counts of the slabs filled so far (the whole grid's once every slab was filled).
+  const FillReport& report() const { return report_; }
+
+ private:
+  Grid slabGrid(std::span<const uint64_t> keys, uint32_t k0, uint32_t k1);
+  FillOptions slabOptions(uint32_t k0, uint32_t k1, bool secondPass) const;
+
+  Grid plan_;
+  const Scene& scene_;
+  FillOptions options_;
+  std::vector<OpenBoundary> boundaries_;
+  FillReport report_;
+  uint32_t nextPlane_ = 0;
+  bool filling_ = false;
+  size_t slab_ = 0;                               // slabs of the current pass so far
+  std::vector<uint64_t> previousPlane_;           // the keys of the previous slab's top plane
+  std::vector<std::vector<uint64_t>> topLabels_;  // per slab: the label of each gap of its top plane, 0 outside
+  std::vector<uint64_t> labelParent_{0};          // union-find over the labels; 0, the outside, stays a root
+};
 
 // One line saying how the fill decided, for the tools' stderr: "closed surface, 389351 solid cells", or
 // "|winding number| >= 0.5 (mesh has 223 open edges), 391664 solid cells (0 enclosed, 391664 by winding number,

@@ -6,10 +6,12 @@
 #include <cmath>
 #include <deque>
 #include <random>
+#include <span>
 
 #include "test_util.h"
 #include "vox/core/error.h"
 #include "vox/import/import.h"
+#include "vox/voxelize/bricks.h"
 #include "vox/voxelize/fill.h"
 #include "vox/voxelize/voxelize.h"
 #include "vox/voxelize/winding_number.h"
@@ -344,6 +346,120 @@ TEST(Fill, SuspiciousResultsAreNamedAndBudgetIsChecked) {
   cancel.rule = FillRule::WindingNumber;
   cancel.progress = [](double) { return false; };
   EXPECT_THROW(fillSolid(whole, scene, cancel), Error);
+}
+
+// SlabFill over `grid` in slabs of 1 to maxPlanes planes (random thickness): its runs, concatenated, and its
+// counts must be fillSolid's.
+void expectSlabFillEqualsFillSolid(const Grid& grid, const Scene& scene, std::mt19937& rng, uint32_t maxPlanes,
+                                   const FillOptions& options, const std::string& what) {
+  Grid whole = grid;
+  const FillReport want = fillSolid(whole, scene, options);
+  std::vector<std::pair<uint32_t, uint32_t>> slabs;
+  for (uint32_t k0 = 0; k0 < grid.dims[2];) {
+    const uint32_t k1 = std::min(grid.dims[2], k0 + 1 + uint32_t(rng() % maxPlanes));
+    slabs.push_back({k0, k1});
+    k0 = k1;
+  }
+  const uint64_t plane = uint64_t(grid.dims[0]) * grid.dims[1];
+  auto keysOf = [&](uint32_t k0, uint32_t k1) {
+    const auto& keys = grid.cellKeys;
+    const auto from = std::lower_bound(keys.begin(), keys.end(), k0 * plane);
+    return std::span<const uint64_t>(from, std::lower_bound(keys.begin(), keys.end(), k1 * plane));
+  };
+  SlabFill fill(grid, scene, options);
+  for (const auto& [k0, k1] : slabs) fill.link(keysOf(k0, k1), k0, k1);
+  std::vector<CellRun> runs;
+  for (const auto& [k0, k1] : slabs)
+    for (const CellRun& r : fill.fill(keysOf(k0, k1), k0, k1)) appendSolidRun(runs, r);
+  ASSERT_EQ(runs.size(), whole.solidRuns.size()) << what << ", " << slabs.size() << " slabs";
+  for (size_t r = 0; r < runs.size(); ++r) {
+    ASSERT_EQ(runs[r].first, whole.solidRuns[r].first) << what << " run " << r;
+    ASSERT_EQ(runs[r].count, whole.solidRuns[r].count) << what << " run " << r;
+  }
+  const FillReport& got = fill.report();
+  EXPECT_EQ(got.rule, want.rule) << what;
+  EXPECT_EQ(got.solidCells, want.solidCells) << what;
+  EXPECT_EQ(got.enclosedCells, want.enclosedCells) << what;
+  EXPECT_EQ(got.windingCells, want.windingCells) << what;
+  EXPECT_EQ(got.emptyCells, want.emptyCells) << what;
+  EXPECT_EQ(got.openEdges, want.openEdges) << what;
+}
+
+// Random occupancy near the percolation threshold: mazes of empty cells that wind up and down through many slabs,
+// join in one slab what was apart in the ones below and reach the outside far from where they started. The slabs'
+// flood must find the single grid's enclosed cells (and the dense reference's); it fails when a component's status
+// is not carried across slab faces in both directions.
+TEST(SlabFill, RandomMazesEqualTheSingleGridsFlood) {
+  std::mt19937 rng(20261202);
+  const Scene empty;  // no triangles: the Enclosed rule, which reads only the cells
+  for (int trial = 0; trial < (kSanitized ? 12 : 60); ++trial) {
+    Grid g;
+    g.bounds = Box{{0, 0, 0}, {1, 1, 1}};
+    g.dims = {2 + uint32_t(rng() % 14), 2 + uint32_t(rng() % 14), 2 + uint32_t(rng() % 40)};
+    // Mostly near the threshold (empty cells percolate above about 31% of a cubic lattice), some far from it.
+    const double density = trial % 5 == 0 ? 0.3 : 0.62 + 0.1 * double(rng() % 1000) / 1000;
+    std::bernoulli_distribution occupied(density);
+    for (uint64_t key = 0; key < g.cellCount(); ++key)
+      if (occupied(rng)) g.cellKeys.push_back(key);
+    g.cellStart.assign(g.cellKeys.size() + 1, 0);
+    const std::string what = "trial " + std::to_string(trial);
+    expectSlabFillEqualsFillSolid(g, empty, rng, 1 + uint32_t(trial % 4), {}, what);
+    Grid reference = g;
+    fillSolid(reference, empty);
+    const std::vector<uint8_t> dense = referenceEnclosed(g), got = solidMask(reference);
+    ASSERT_EQ(got, dense) << what;
+  }
+}
+
+// Open and closed meshes (the WindingNumber rule with its hole caps, and the flood), spheres, in slabs of 1 to 3
+// planes.
+TEST(SlabFill, MeshesEqualTheSingleGridsFill) {
+  std::mt19937 rng(7);
+  Scene cup = testing::boxScene(0.2, 0.8);
+  cup.triangles.erase(cup.triangles.begin() + 2, cup.triangles.begin() + 4);  // the top face (z = 0.8) removed
+  Scene boxes = testing::boxScene(0.1, 0.45);
+  for (const Triangle& t : testing::boxScene(0.3, 0.9).triangles) boxes.triangles.push_back(t);
+  const Scene bunny = loadScene(seed("meshes/bun_zipper.ply"));
+  Scene spheres;
+  spheres.materials.push_back({});
+  spheres.spheres.push_back({{0.35, 0.4, 0.5}, 0.25, {}, 0});
+  spheres.spheres.push_back({{0.6, 0.55, 0.45}, 0.2, {}, 0});
+  const std::pair<const char*, const Scene*> scenes[] = {
+      {"cup", &cup}, {"two boxes", &boxes}, {"open bunny", &bunny}, {"spheres", &spheres}};
+  for (const auto& [name, scene] : scenes) {
+    for (const uint32_t n : {11u, kSanitized ? 24u : 47u}) {
+      VoxelizeOptions o;
+      o.dims = std::array<uint32_t, 3>{n, n + 2, n - 3};
+      if (scene != &bunny) o.bounds = Box{{0, 0, 0}, {1, 1, 1}};
+      const Grid grid = voxelizeScene(*scene, o);
+      const std::string what = std::string(name) + " at " + std::to_string(n);
+      expectSlabFillEqualsFillSolid(grid, *scene, rng, 3, {}, what);
+      FillOptions flood;  // the cup's inside reaches the outside only through the planes above it
+      flood.rule = FillRule::Enclosed;
+      expectSlabFillEqualsFillSolid(grid, *scene, rng, 2, flood, what + ", flood");
+    }
+  }
+}
+
+// Slabs out of order, a fill before every plane was linked, or cells outside their slab are refused.
+TEST(SlabFill, MisuseIsRefused) {
+  Grid g;
+  g.bounds = Box{{0, 0, 0}, {1, 1, 1}};
+  g.dims = {4, 4, 4};
+  g.cellKeys = {5, 21, 37};
+  const Scene empty;
+  const std::span<const uint64_t> none;
+  {
+    SlabFill fill(g, empty, {});
+    EXPECT_THROW(fill.link(none, 1, 2), Error);  // not from plane 0
+    fill.link(std::span<const uint64_t>(g.cellKeys), 0, 3);
+    EXPECT_THROW(fill.fill(none, 0, 4), Error);  // plane 3 never linked
+  }
+  {
+    SlabFill fill(g, empty, {});
+    const uint64_t outside[] = {40};  // plane 2
+    EXPECT_THROW(fill.link(std::span<const uint64_t>(outside), 0, 2), Error);
+  }
 }
 
 }  // namespace

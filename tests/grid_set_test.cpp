@@ -167,7 +167,7 @@ TEST(GridSet, NoManifestWhenABrickCannotBeWritten) {
 }
 
 // --fill over a set gives the single grid's solid cells, run for run, for closed (flood) and open (winding number)
-// surfaces, spheres, and brick counts from one brick to bricks of one cell.
+// surfaces, spheres, brick counts from one brick to bricks of one cell, and slabs from one plane to whole layers.
 TEST(GridSet, FillEqualsTheSingleGridsFill) {
   testing::ScratchDir dir("gridset_fill");
   Scene open = testing::boxScene(0.15, 0.85);
@@ -199,10 +199,14 @@ TEST(GridSet, FillEqualsTheSingleGridsFill) {
     ASSERT_GT(want.solidCells, 10u) << c.name;
     // Bricks of one cell for the small grids (a file each); the bunny's grid in bricks of a few cells.
     const std::array<uint32_t, 3> finest = c.scene == &bunny ? std::array<uint32_t, 3>{13, 5, 4} : c.dims;
+    // Slabs of one plane, of a few planes and of whole layers (the default).
+    const uint64_t slabCells[] = {1, 60, FillOptions{}.slabCells};
+    int turn = 0;
     for (const auto bricks : {std::array<uint32_t, 3>{1, 1, 1}, {7, 5, 3}, {2, 1, 4}, {1, 3, 1}, finest}) {
       const std::string path = dir.file("f.vgrid");
       std::filesystem::remove_all(dir.file("f.bricks"));
-      const FillOptions fo;
+      FillOptions fo;
+      fo.slabCells = slabCells[turn++ % 3];
       FillReport got;
       const GridSetManifest m = writeGridSet(path, *c.scene, o, bricks, nullptr, &fo, &got);
       const std::string what = std::string(c.name) + " in " + std::to_string(bricks[0]) + "x" +

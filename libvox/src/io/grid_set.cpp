@@ -271,15 +271,10 @@ void sortLayer(Grid& grid, LayerCells cells) {
 
 void forEachGridSetLayer(const std::string& setPath, const GridSetManifest& m, const GridFile& sceneFile,
                          const std::function<void(const Grid& layer)>& visit, LayerCells cells) {
-  forEachGridSetLayer(setPath, m, sceneFile.scene.boundedCount(), visit, cells);
-}
-
-void forEachGridSetLayer(const std::string& setPath, const GridSetManifest& m, uint64_t boundedCount,
-                         const std::function<void(const Grid& layer)>& visit, LayerCells cells) {
   size_t i = 0;
   // One grid for every layer: its arrays keep their capacity from layer to layer instead of being allocated and
   // faulted in again (page faults were a fifth of a .vox export's time).
-  Grid layer = emptyGridLike(m);
+  Grid layer = emptyGridLike(sceneFile.grid);
   for (uint32_t bz = 0; bz < m.bricks[2]; ++bz) {
     layer.cellKeys.clear();
     layer.cellStart.assign(1, 0);
@@ -297,7 +292,7 @@ void forEachGridSetLayer(const std::string& setPath, const GridSetManifest& m, u
     if (cells != LayerCells::KeysOnly) layer.cellStart.reserve(occupied + 1);
     if (cells == LayerCells::Sorted || cells == LayerCells::BrickOrder) layer.primIds.reserve(references);
     for (; i < end; ++i) {
-      Grid brick = readBrick(setPath, m, i, boundedCount);
+      Grid brick = readBrick(setPath, m, i, sceneFile.scene.boundedCount());
       if (cells == LayerCells::KeysOnly) brick.cellStart = {0};
       if (cells == LayerCells::KeysOnly || cells == LayerCells::KeysAndCounts)
         std::vector<uint32_t>().swap(brick.primIds);

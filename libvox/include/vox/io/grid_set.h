@@ -76,12 +76,13 @@ BrickEntry writeBrick(const std::string& setPath, const GridSetManifest& set, co
                       const std::array<uint32_t, 3>& index, std::span<const uint32_t> candidates,
                       const VoxelizeOptions& options, VoxelizeStats* stats = nullptr);
 
-// --fill for a set whose bricks are written: reads the bricks' occupied cells one layer of bricks at a time (8 bytes
-// a cell, not their primitive lists), twice, and fills them in slabs of planes (SlabFill, options.slabCells cells a
-// slab), so that the solid cells are the single grid's while memory stays about one layer's keys and one slab's
-// scratch. After each layer's second reading, its solid runs are split by brick and the bricks holding solid cells
-// rewritten (new ones written for bricks holding only solid cells). Updates set.entries (ascending). Throws as
-// fillSolid, InputError for a corrupt brick, OutputError.
+// --fill for a set whose bricks are written, in memory bounded by a brick rather than the grid: fills the set's
+// occupied cells in slabs of whole planes (SlabFill, options.slabCells cells a slab), so that the solid cells are
+// the single grid's, run for run. Reads the bricks one layer (bz) at a time, twice, keeping a layer's cell keys
+// delta-coded (1 to 2 bytes a cell of a surface) and one slab's keys and scratch. After a layer's second reading,
+// its solid runs are split by brick and the bricks holding solid cells rewritten (new ones written for bricks
+// holding only solid cells). Updates set.entries (ascending). Throws as fillSolid, InputError for a corrupt brick,
+// OutputError.
 FillReport fillGridSet(const std::string& setPath, GridSetManifest& set, const Scene& scene,
                        const FillOptions& options);
 
@@ -131,9 +132,6 @@ enum class LayerCells : uint8_t { Sorted, BrickOrder, KeysOnly, KeysAndCounts };
 // fastest, so the cells of a layer's bricks interleave): `visit` gets each layer's cells as `cells` says and its
 // solid runs sorted, merged within the layer. Peak memory is one layer, not the grid. Throws as readBrick.
 void forEachGridSetLayer(const std::string& setPath, const GridSetManifest& manifest, const GridFile& sceneFile,
-                         const std::function<void(const Grid& layer)>& visit, LayerCells cells = LayerCells::Sorted);
-// The same with the scene's Scene::boundedCount alone (primitive ids are checked against it).
-void forEachGridSetLayer(const std::string& setPath, const GridSetManifest& manifest, uint64_t boundedCount,
                          const std::function<void(const Grid& layer)>& visit, LayerCells cells = LayerCells::Sorted);
 
 // The whole grid of a set in memory: the bricks' cells merged. Equal to the grid the single-process voxelizer

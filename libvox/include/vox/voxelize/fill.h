@@ -42,7 +42,7 @@ struct FillOptions {
   bool windingOnly = false;
   // Grid sets (fillGridSet): occupied cells per slab of whole z planes (a plane is never split), which bounds the
   // fill's scratch memory to about one slab's.
-  uint64_t slabCells = uint64_t(1) << 22;
+  uint64_t slabCells = uint64_t(1) << 21;
 };
 
 struct FillReport {

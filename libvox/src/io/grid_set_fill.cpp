@@ -1,0 +1,166 @@
+// --fill over a grid set (fillGridSet): the single grid's fill, decided slab by slab (SlabFill) from the bricks' cell
+// keys, in memory bounded by a layer of bricks' keys delta-coded, one brick and one slab rather than the grid.
+#include <algorithm>
+#include <cstring>
+
+#include "io/grid_set_header.h"
+#include "vox/io/grid_set.h"
+
+namespace vox {
+
+namespace {
+
+// The sorted keys of one brick, delta-coded as LEB128 varints: a run of cells along x costs a byte a cell, a step
+// to the next row two or three, instead of 8 bytes a key. Read back in order, up to a key bound at a time.
+struct PackedKeys {
+  std::vector<uint8_t> bytes;
+  size_t pos = 0;     // read cursor into bytes
+  uint64_t last = 0;  // the last key packed, then the last key read
+
+  explicit PackedKeys(std::span<const uint64_t> keys) {
+    bytes.reserve(keys.size() + keys.size() / 4);
+    for (const uint64_t key : keys) {
+      for (uint64_t delta = key - last;; delta >>= 7) {
+        const uint8_t low = uint8_t(delta & 0x7f);
+        if (delta < 0x80) {
+          bytes.push_back(low);
+          break;
+        }
+        bytes.push_back(low | 0x80);
+      }
+      last = key;
+    }
+    last = 0;
+  }
+  // Appends to `out` the keys not read yet that lie below `end`.
+  void readBelow(uint64_t end, std::vector<uint64_t>& out) {
+    while (pos < bytes.size()) {
+      uint64_t delta = 0;
+      size_t p = pos;
+      for (int shift = 0;; shift += 7) {
+        const uint8_t b = bytes[p++];
+        delta |= uint64_t(b & 0x7f) << shift;
+        if (!(b & 0x80)) break;
+      }
+      if (last + delta >= end) return;
+      last += delta;
+      pos = p;
+      out.push_back(last);
+    }
+  }
+};
+
+// One layer of bricks (all with one bz) as SlabFill reads it: each brick's keys packed, and the cells per plane.
+struct PackedLayer {
+  uint32_t firstPlane = 0, endPlane = 0;
+  std::vector<PackedKeys> bricks;
+  std::vector<uint64_t> cellsPerPlane;  // plane firstPlane + p holds cellsPerPlane[p] occupied cells
+};
+
+// Reads the bricks of layer `bz`, entries [first, end) of the manifest.
+PackedLayer readPackedLayer(const std::string& setPath, const GridSetManifest& set, uint32_t bz, size_t first,
+                            size_t end, uint64_t boundedCount) {
+  PackedLayer layer;
+  const CellWindow window = brickWindow(set.dims, set.bricks, {0, 0, bz});
+  layer.firstPlane = window.first[2], layer.endPlane = window.end[2];
+  layer.cellsPerPlane.assign(layer.endPlane - layer.firstPlane, 0);
+  const uint64_t plane = uint64_t(set.dims[0]) * set.dims[1];
+  for (size_t i = first; i < end; ++i) {
+    const Grid brick = readBrick(setPath, set, i, boundedCount);  // keys checked inside the brick, sorted
+    for (const uint64_t key : brick.cellKeys) ++layer.cellsPerPlane[key / plane - layer.firstPlane];
+    layer.bricks.emplace_back(brick.cellKeys);
+  }
+  return layer;
+}
+
+// Calls slab(keys, k0, k1) for consecutive slabs of whole planes of every layer, bottom to top, each holding at most
+// `slabCells` cells unless one plane holds more, and layerDone(bz) after each layer's slabs.
+template <typename Slab, typename LayerDone>
+void forEachSlab(const std::string& setPath, const GridSetManifest& set, uint64_t boundedCount, uint64_t slabCells,
+                 const Slab& slab, const LayerDone& layerDone) {
+  const uint64_t plane = uint64_t(set.dims[0]) * set.dims[1];
+  std::vector<uint64_t> keys;
+  size_t first = 0;
+  for (uint32_t bz = 0; bz < set.bricks[2]; ++bz) {
+    size_t end = first;
+    while (end < set.entries.size() && set.entries[end].index[2] == bz) ++end;
+    PackedLayer layer = readPackedLayer(setPath, set, bz, first, end, boundedCount);
+    first = end;
+    for (uint32_t k0 = layer.firstPlane; k0 < layer.endPlane;) {
+      uint32_t k1 = k0 + 1;
+      uint64_t cells = layer.cellsPerPlane[k0 - layer.firstPlane];
+      while (k1 < layer.endPlane && cells + layer.cellsPerPlane[k1 - layer.firstPlane] <= slabCells)
+        cells += layer.cellsPerPlane[k1++ - layer.firstPlane];
+      keys.clear();
+      keys.reserve(cells);
+      // A row crosses the bricks of its layer along x, so the bricks' keys interleave row by row.
+      for (PackedKeys& brick : layer.bricks) brick.readBelow(k1 * plane, keys);
+      std::sort(keys.begin(), keys.end());
+      slab(std::span<const uint64_t>(keys), k0, k1);
+      k0 = k1;
+    }
+    layerDone(bz);
+  }
+}
+
+// Writes the bricks holding the solid runs `runs` (of one layer): each existing brick rewritten with its runs, a new
+// one for a brick holding only solid cells. Returns their entries, ascending by brick number.
+std::vector<BrickEntry> writeSolidBricks(const std::string& setPath, const GridSetManifest& set,
+                                         std::span<const CellRun> runs, uint64_t boundedCount) {
+  std::vector<BrickEntry> written;
+  for (auto& [number, brickRuns] : splitRunsByBrick(runs, set.dims, set.bricks)) {
+    const auto e =
+        std::lower_bound(set.entries.begin(), set.entries.end(), number,
+                         [&](const BrickEntry& entry, uint64_t n) { return brickNumber(set.bricks, entry.index) < n; });
+    Grid cells = emptyGridLike(set);
+    if (e != set.entries.end() && brickNumber(set.bricks, e->index) == number)
+      cells = readBrick(setPath, set, size_t(e - set.entries.begin()), boundedCount);
+    cells.solidRuns = std::move(brickRuns);
+    written.push_back(writeBrickFile(setPath, set, brickIndex(set.bricks, number), cells));
+  }
+  return written;
+}
+
+// `entries` with the `written` ones in place of those of the same brick (both ascending by brick number).
+std::vector<BrickEntry> mergeEntries(const GridSetManifest& set, const std::vector<BrickEntry>& written) {
+  std::vector<BrickEntry> entries;
+  entries.reserve(set.entries.size() + written.size());
+  auto number = [&](const BrickEntry& e) { return brickNumber(set.bricks, e.index); };
+  size_t w = 0;
+  for (const BrickEntry& e : set.entries) {
+    while (w < written.size() && number(written[w]) < number(e)) entries.push_back(written[w++]);
+    if (w < written.size() && number(written[w]) == number(e))
+      entries.push_back(written[w++]);
+    else
+      entries.push_back(e);
+  }
+  entries.insert(entries.end(), written.begin() + ptrdiff_t(w), written.end());
+  return entries;
+}
+
+}  // namespace
+
+FillReport fillGridSet(const std::string& setPath, GridSetManifest& set, const Scene& scene,
+                       const FillOptions& options) {
+  const uint64_t boundedCount = scene.boundedCount();
+  SlabFill fill(emptyGridLike(set), scene, options);
+  forEachSlab(
+      setPath, set, boundedCount, options.slabCells,
+      [&](std::span<const uint64_t> keys, uint32_t k0, uint32_t k1) { fill.link(keys, k0, k1); }, [](uint32_t) {});
+  // The second reading decides each layer's runs; its bricks are rewritten once the layer is done.
+  std::vector<BrickEntry> written;
+  std::vector<CellRun> runs;
+  forEachSlab(
+      setPath, set, boundedCount, options.slabCells,
+      [&](std::span<const uint64_t> keys, uint32_t k0, uint32_t k1) {
+        for (const CellRun& run : fill.fill(keys, k0, k1)) appendSolidRun(runs, run);
+      },
+      [&](uint32_t) {
+        for (const BrickEntry& e : writeSolidBricks(setPath, set, runs, boundedCount)) written.push_back(e);
+        std::vector<CellRun>().swap(runs);
+      });
+  set.entries = mergeEntries(set, written);
+  return fill.report();
+}
+
+}  // namespace vox

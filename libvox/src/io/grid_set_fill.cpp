@@ -103,23 +103,39 @@ void forEachSlab(const std::string& setPath, const GridSetManifest& set, uint64_
   }
 }
 
-// Writes the bricks holding the solid runs `runs` (of one layer): each existing brick rewritten with its runs, a new
-// one for a brick holding only solid cells. Returns their entries, ascending by brick number.
-std::vector<BrickEntry> writeSolidBricks(const std::string& setPath, const GridSetManifest& set,
-                                         std::span<const CellRun> runs, uint64_t boundedCount) {
-  std::vector<BrickEntry> written;
-  for (auto& [number, brickRuns] : splitRunsByBrick(runs, set.dims, set.bricks)) {
-    const auto e =
-        std::lower_bound(set.entries.begin(), set.entries.end(), number,
-                         [&](const BrickEntry& entry, uint64_t n) { return brickNumber(set.bricks, entry.index) < n; });
-    Grid cells = emptyGridLike(set);
-    if (e != set.entries.end() && brickNumber(set.bricks, e->index) == number)
-      cells = readBrick(setPath, set, size_t(e - set.entries.begin()), boundedCount);
-    cells.solidRuns = std::move(brickRuns);
-    written.push_back(writeBrickFile(setPath, set, brickIndex(set.bricks, number), cells));
+// The solid runs of one layer of bricks, split by brick as they come (slab by slab, ascending): no copy of the
+// layer's runs is held beside them.
+struct LayerRuns {
+  std::vector<std::vector<CellRun>> byBrick;  // brick bx + BX by of the layer
+
+  void add(const GridSetManifest& set, std::span<const CellRun> runs) {
+    byBrick.resize(uint64_t(set.bricks[0]) * set.bricks[1]);
+    for (auto& [number, brickRuns] : splitRunsByBrick(runs, set.dims, set.bricks)) {
+      const auto index = brickIndex(set.bricks, number);
+      for (const CellRun& run : brickRuns) appendSolidRun(byBrick[index[0] + uint64_t(set.bricks[0]) * index[1]], run);
+    }
   }
-  return written;
-}
+  // Writes the bricks of layer `bz` holding solid runs: each existing brick rewritten with its runs, a new one for a
+  // brick holding only solid cells. Appends their entries to `written`, ascending by brick number, and empties the
+  // layer.
+  void write(const std::string& setPath, const GridSetManifest& set, uint32_t bz, uint64_t boundedCount,
+             std::vector<BrickEntry>& written) {
+    for (uint64_t b = 0; b < byBrick.size(); ++b) {
+      if (byBrick[b].empty()) continue;
+      const std::array<uint32_t, 3> index{uint32_t(b % set.bricks[0]), uint32_t(b / set.bricks[0]), bz};
+      const uint64_t number = brickNumber(set.bricks, index);
+      const auto e = std::lower_bound(
+          set.entries.begin(), set.entries.end(), number,
+          [&](const BrickEntry& entry, uint64_t n) { return brickNumber(set.bricks, entry.index) < n; });
+      Grid cells = emptyGridLike(set);
+      if (e != set.entries.end() && brickNumber(set.bricks, e->index) == number)
+        cells = readBrick(setPath, set, size_t(e - set.entries.begin()), boundedCount);
+      cells.solidRuns = std::move(byBrick[b]);
+      std::vector<CellRun>().swap(byBrick[b]);
+      written.push_back(writeBrickFile(setPath, set, index, cells));
+    }
+  }
+};
 
 // `entries` with the `written` ones in place of those of the same brick (both ascending by brick number).
 std::vector<BrickEntry> mergeEntries(const GridSetManifest& set, const std::vector<BrickEntry>& written) {
@@ -149,16 +165,11 @@ FillReport fillGridSet(const std::string& setPath, GridSetManifest& set, const S
       [&](std::span<const uint64_t> keys, uint32_t k0, uint32_t k1) { fill.link(keys, k0, k1); }, [](uint32_t) {});
   // The second reading decides each layer's runs; its bricks are rewritten once the layer is done.
   std::vector<BrickEntry> written;
-  std::vector<CellRun> runs;
+  LayerRuns runs;
   forEachSlab(
       setPath, set, boundedCount, options.slabCells,
-      [&](std::span<const uint64_t> keys, uint32_t k0, uint32_t k1) {
-        for (const CellRun& run : fill.fill(keys, k0, k1)) appendSolidRun(runs, run);
-      },
-      [&](uint32_t) {
-        for (const BrickEntry& e : writeSolidBricks(setPath, set, runs, boundedCount)) written.push_back(e);
-        std::vector<CellRun>().swap(runs);
-      });
+      [&](std::span<const uint64_t> keys, uint32_t k0, uint32_t k1) { runs.add(set, fill.fill(keys, k0, k1)); },
+      [&](uint32_t bz) { runs.write(setPath, set, bz, boundedCount, written); });
   set.entries = mergeEntries(set, written);
   return fill.report();
 }

@@ -10,43 +10,76 @@ namespace vox {
 
 namespace {
 
-// The sorted keys of one brick, delta-coded as LEB128 varints: a run of cells along x costs a byte a cell, a step
-// to the next row two or three, instead of 8 bytes a key. Read back in order, up to a key bound at a time.
+// LEB128: seven bits a byte, low first, the top bit saying another byte follows. Only our own bytes are read.
+void appendVarint(std::vector<uint8_t>& bytes, uint64_t v) {
+  for (; v >= 0x80; v >>= 7) bytes.push_back(uint8_t(v & 0x7f) | 0x80);
+  bytes.push_back(uint8_t(v));
+}
+uint64_t readVarint(const std::vector<uint8_t>& bytes, size_t& pos) {
+  uint64_t v = 0;
+  for (int shift = 0;; shift += 7) {
+    const uint8_t b = bytes[pos++];
+    v |= uint64_t(b & 0x7f) << shift;
+    if (!(b & 0x80)) return v;
+  }
+}
+
+// The sorted keys of one brick, delta-coded: a run of cells along x costs a byte a cell, a step to the next row two
+// or three, instead of 8 bytes a key. Read back in order, up to a key bound at a time.
 struct PackedKeys {
   std::vector<uint8_t> bytes;
   size_t pos = 0;     // read cursor into bytes
-  uint64_t last = 0;  // the last key packed, then the last key read
+  uint64_t last = 0;  // the last key read
 
   explicit PackedKeys(std::span<const uint64_t> keys) {
     bytes.reserve(keys.size() + keys.size() / 4);
-    for (const uint64_t key : keys) {
-      for (uint64_t delta = key - last;; delta >>= 7) {
-        const uint8_t low = uint8_t(delta & 0x7f);
-        if (delta < 0x80) {
-          bytes.push_back(low);
-          break;
-        }
-        bytes.push_back(low | 0x80);
-      }
-      last = key;
-    }
-    last = 0;
+    uint64_t previous = 0;
+    for (const uint64_t key : keys) appendVarint(bytes, key - previous), previous = key;
   }
   // Appends to `out` the keys not read yet that lie below `end`.
   void readBelow(uint64_t end, std::vector<uint64_t>& out) {
     while (pos < bytes.size()) {
-      uint64_t delta = 0;
       size_t p = pos;
-      for (int shift = 0;; shift += 7) {
-        const uint8_t b = bytes[p++];
-        delta |= uint64_t(b & 0x7f) << shift;
-        if (!(b & 0x80)) break;
-      }
-      if (last + delta >= end) return;
-      last += delta;
-      pos = p;
-      out.push_back(last);
+      const uint64_t key = last + readVarint(bytes, p);
+      if (key >= end) return;
+      last = key, pos = p;
+      out.push_back(key);
     }
+  }
+};
+
+// The solid runs of one brick as they come, ascending, merged where they touch and delta-coded (gap from the previous
+// run's end, count: a few bytes a run instead of 16). A layer's runs are what the fill holds longest.
+struct PackedRuns {
+  std::vector<uint8_t> bytes;
+  CellRun pending{0, 0};  // the last run, which the next may extend
+  uint64_t end = 0;       // the end of the last run packed
+
+  void add(const CellRun& run) {
+    if (pending.count > 0 && pending.first + pending.count == run.first) {
+      pending.count += run.count;
+      return;
+    }
+    flush();
+    pending = run;
+  }
+  void flush() {
+    if (pending.count == 0) return;
+    appendVarint(bytes, pending.first - end);
+    appendVarint(bytes, pending.count);
+    end = pending.first + pending.count;
+    pending = {0, 0};
+  }
+  std::vector<CellRun> unpack() {
+    flush();
+    std::vector<CellRun> runs;
+    uint64_t at = 0;
+    for (size_t pos = 0; pos < bytes.size();) {
+      const uint64_t first = at + readVarint(bytes, pos), count = readVarint(bytes, pos);
+      runs.push_back({first, count});
+      at = first + count;
+    }
+    return runs;
   }
 };
 
@@ -106,13 +139,13 @@ void forEachSlab(const std::string& setPath, const GridSetManifest& set, uint64_
 // The solid runs of one layer of bricks, split by brick as they come (slab by slab, ascending): no copy of the
 // layer's runs is held beside them.
 struct LayerRuns {
-  std::vector<std::vector<CellRun>> byBrick;  // brick bx + BX by of the layer
+  std::vector<PackedRuns> byBrick;  // brick bx + BX by of the layer
 
   void add(const GridSetManifest& set, std::span<const CellRun> runs) {
     byBrick.resize(uint64_t(set.bricks[0]) * set.bricks[1]);
     for (auto& [number, brickRuns] : splitRunsByBrick(runs, set.dims, set.bricks)) {
       const auto index = brickIndex(set.bricks, number);
-      for (const CellRun& run : brickRuns) appendSolidRun(byBrick[index[0] + uint64_t(set.bricks[0]) * index[1]], run);
+      for (const CellRun& run : brickRuns) byBrick[index[0] + uint64_t(set.bricks[0]) * index[1]].add(run);
     }
   }
   // Writes the bricks of layer `bz` holding solid runs: each existing brick rewritten with its runs, a new one for a
@@ -121,7 +154,7 @@ struct LayerRuns {
   void write(const std::string& setPath, const GridSetManifest& set, uint32_t bz, uint64_t boundedCount,
              std::vector<BrickEntry>& written) {
     for (uint64_t b = 0; b < byBrick.size(); ++b) {
-      if (byBrick[b].empty()) continue;
+      if (byBrick[b].bytes.empty() && byBrick[b].pending.count == 0) continue;
       const std::array<uint32_t, 3> index{uint32_t(b % set.bricks[0]), uint32_t(b / set.bricks[0]), bz};
       const uint64_t number = brickNumber(set.bricks, index);
       const auto e = std::lower_bound(
@@ -130,8 +163,8 @@ struct LayerRuns {
       Grid cells = emptyGridLike(set);
       if (e != set.entries.end() && brickNumber(set.bricks, e->index) == number)
         cells = readBrick(setPath, set, size_t(e - set.entries.begin()), boundedCount);
-      cells.solidRuns = std::move(byBrick[b]);
-      std::vector<CellRun>().swap(byBrick[b]);
+      cells.solidRuns = byBrick[b].unpack();
+      byBrick[b] = {};
       written.push_back(writeBrickFile(setPath, set, index, cells));
     }
   }

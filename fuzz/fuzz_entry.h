@@ -25,6 +25,7 @@
 #include "vox/io/input_file.h"
 #include "vox/import/import.h"
 #include "vox/trace/render.h"
+#include "vox/export/voxel_format.h"
 #include "vox/export/voxel_mesh.h"
 
 namespace vox::fuzz {
@@ -162,10 +163,43 @@ inline void checkSetError(const Error& e, const std::string& folder) {
   }
 }
 
+// binvox and .vox of a set that read whole as `file`: written from the assembled grid and lazily, layer by layer
+// (writeGridSetVoxelFile, as vox-export does for a set). Either both writers refuse or both write the same bytes.
+// Only for grids of up to 2^21 cells: binvox writes every cell of its cube.
+inline void compareSetVoxelFiles(const GridFile& file, const std::string& setPath) {
+  if (file.grid.cellCount() > (uint64_t(1) << 21)) return;
+  const GridSetManifest m = readGridSetManifest(setPath);
+  const GridFile sceneFile = readGridSetScene(setPath, m);
+  for (const auto& [format, extension] :
+       {std::pair{VoxelFormat::Binvox, ".binvox"}, {VoxelFormat::MagicaVoxel, ".vox"}}) {
+    const std::string wholePath = privateFolder() + "/whole" + extension,
+                      lazyPath = privateFolder() + "/lazy" + extension;
+    std::string whole, lazy;
+    bool wholeWritten = false, lazyWritten = false;
+    try {
+      writeVoxelFile(wholePath, format, file.grid, occupiedCellColors(file.grid, file.scene, ColorMode::Count));
+      whole = readInputFile(wholePath, "voxel file"), wholeWritten = true;
+    } catch (const Error&) {
+    }
+    try {
+      writeGridSetVoxelFile(lazyPath, format, setPath, m, sceneFile, ColorMode::Count);
+      lazy = readInputFile(lazyPath, "voxel file"), lazyWritten = true;
+    } catch (const Error&) {
+    }
+    if (wholeWritten != lazyWritten || whole != lazy) {
+      std::fprintf(stderr, "%s of the assembled set %s, of its layers %s, files %s\n", extension,
+                   wholeWritten ? "written" : "refused", lazyWritten ? "written" : "refused",
+                   whole == lazy ? "equal" : "differ");
+      std::abort();
+    }
+  }
+}
+
 // Reads a grid set made of `bytes` (parts split by kSetPartMarker): headers fixed, then, when the manifest decodes,
 // its listed sizes and checksums set to the parts given (so the bricks' contents are reached), each part written
 // where the manifest names it inside the private folder, and the set read whole (readGridOrSet, as vox-trace and
-// vox-export do: then traced and meshed) and lazily (writeGridSetInfo, as vox-info does). Findings besides crashes:
+// vox-export do: then traced, meshed and written as binvox and .vox, compared with the lazy writer) and lazily
+// (writeGridSetInfo, as vox-info does). Findings besides crashes:
 // a read that succeeds with a name leading out of the set's folder, an error that is not one line naming the set's
 // file, and the two readers disagreeing (one refuses what the other reads, or their vox-info output differs).
 inline void readGridSetBytes(std::string_view input) {
@@ -215,6 +249,7 @@ inline void readGridSetBytes(std::string_view input) {
       }
     whole = formatGridInfo(file, options);
     exerciseDecodedGrid(file);
+    compareSetVoxelFiles(file, path);
   } catch (const Error& e) {
     checkSetError(e, folder.string());
   }

@@ -4,10 +4,10 @@
 
 #include <algorithm>
 #include <atomic>
+#include <memory>
 #include <numbers>
 #include <cmath>
 #include <limits>
-#include <optional>
 #include <sstream>
 #include <tuple>
 #include <unordered_map>
@@ -474,16 +474,29 @@ int64_t neighbourK(const Grid& grid, const RowTable& t, const HoleCaps& caps, co
   return kUnknown;
 }
 
+}  // namespace
+
+// What the WindingNumber rule evaluates, built from the scene alone: once per fill (SlabFill: not once per slab; the
+// tree of the 69k bunny takes about 90 ms).
+struct FillWinding {
+  SceneWinding scene;
+  HoleCaps caps;
+  FillWinding(const Scene& s, std::vector<OpenBoundary>&& boundaries, const Grid& grid)
+      : scene(s), caps(std::move(boundaries), grid.method == OverlapMethod::Center) {}
+};
+
+namespace {
+
 // The solid part of every empty run of the listed rows: enclosed gaps whole; under the WindingNumber rule the other
 // runs by their group's k (HoleCaps), by k minus the caps' winding number, or, where a cap crosses the run, by the
-// winding number itself. Rows before `firstRow` (a SlabFill's plane below the slab) are left undecided and serve
-// no neighbour. Returns the evaluations of the mesh's winding number and of the caps'.
-std::pair<uint64_t, uint64_t> decideRuns(const Grid& grid, const Scene& scene, std::vector<OpenBoundary>&& boundaries,
-                                         const RowTable& t, const std::vector<uint8_t>& enclosed, bool winding,
-                                         const FillOptions& options, size_t firstRow, std::vector<Piece>& pieces) {
-  std::optional<SceneWinding> w;
-  std::optional<HoleCaps> caps;
-  if (winding) w.emplace(scene), caps.emplace(std::move(boundaries), grid.method == OverlapMethod::Center);
+// winding number itself (`winding` given: the WindingNumber rule). Rows before `firstRow` (a SlabFill's plane below the
+// slab) are left undecided and serve no neighbour. Returns the evaluations of the mesh's winding number and of the
+// caps'.
+std::pair<uint64_t, uint64_t> decideRuns(const Grid& grid, const FillWinding* winding, const RowTable& t,
+                                         const std::vector<uint8_t>& enclosed, const FillOptions& options,
+                                         size_t firstRow, std::vector<Piece>& pieces) {
+  const SceneWinding* w = winding ? &winding->scene : nullptr;
+  const HoleCaps* caps = winding ? &winding->caps : nullptr;
   std::vector<uint8_t> state(pieces.size(), kNone);
   RowSweep sweep{t, grid, options, firstRow};
   const uint64_t nx = grid.dims[0];
@@ -560,9 +573,10 @@ std::pair<uint64_t, uint64_t> decideRuns(const Grid& grid, const Scene& scene, s
   });
   return {sweep.full, sweep.caps};
 }
-// The report's rule and the holes' boundaries, from the scene alone; LimitError when the winding tree would not fit.
+// The report's rule, and under the WindingNumber rule what it evaluates (`winding`), from the scene alone; LimitError
+// when the winding tree would not fit.
 FillReport startFill(const Grid& grid, const Scene& scene, const FillOptions& options,
-                     std::vector<OpenBoundary>& boundaries) {
+                     std::shared_ptr<const FillWinding>& winding) {
   FillReport report;
   report.leakyMethod = grid.method == OverlapMethod::Center;
   // The tree and its build, the edge weld, and the holes' caps (up to three triangles per triangle).
@@ -571,9 +585,11 @@ FillReport startFill(const Grid& grid, const Scene& scene, const FillOptions& op
     fail<LimitError>("solid fill of ", scene.triangles.size(), " triangles needs about ",
                      uint64_t(treeBytes / (1 << 20)), " MiB of scratch memory, more than the ",
                      options.memoryLimitBytes >> 20, " MiB allowed");
-  boundaries = openBoundaries(scene.triangles, &report.openEdges, HoleCaps::kMaxBoundaries);
+  std::vector<OpenBoundary> boundaries = openBoundaries(scene.triangles, &report.openEdges, HoleCaps::kMaxBoundaries);
   report.rule = report.openEdges > 0 || report.leakyMethod ? FillRule::WindingNumber : FillRule::Enclosed;
   if (options.rule) report.rule = *options.rule;
+  if (report.rule == FillRule::WindingNumber)
+    winding = std::make_shared<const FillWinding>(scene, std::move(boundaries), grid);
   return report;
 }
 
@@ -587,9 +603,9 @@ std::vector<uint8_t> enclosedGaps(const RowTable& t, UnionFind& uf, const IsOuts
 
 // The solid runs of the table's rows from `firstRow` on, sorted and merged where they touch, under report.rule;
 // adds their counts to `report`.
-std::vector<CellRun> solidRuns(const Grid& grid, const Scene& scene, std::vector<OpenBoundary>&& boundaries,
-                               const RowTable& t, const std::vector<uint8_t>& enclosed, size_t firstRow,
-                               const FillOptions& options, FillReport& report) {
+std::vector<CellRun> solidRuns(const Grid& grid, const FillWinding* winding, const RowTable& t,
+                               const std::vector<uint8_t>& enclosed, size_t firstRow, const FillOptions& options,
+                               FillReport& report) {
   std::vector<CellRun> runs;
   uint64_t enclosedCells = 0;
   for (uint64_t g = t.gapBegin[firstRow]; g < t.gaps.size(); ++g)
@@ -604,8 +620,7 @@ std::vector<CellRun> solidRuns(const Grid& grid, const Scene& scene, std::vector
     return runs;
   }
   std::vector<Piece> pieces(t.gaps.size() + 2 * t.row.size());
-  const auto [full, caps] = decideRuns(grid, scene, std::move(boundaries), t, enclosed,
-                                       report.rule == FillRule::WindingNumber, options, firstRow, pieces);
+  const auto [full, caps] = decideRuns(grid, winding, t, enclosed, options, firstRow, pieces);
   report.windingQueries += full;
   report.capQueries += caps;
   // Reserved once: growing a vector of millions of runs costs more in page faults than the loop itself.
@@ -658,8 +673,8 @@ SlabLinks linkSlab(Grid&& grid, uint32_t k0, uint32_t k1, uint64_t memoryLimitBy
 }  // namespace
 
 FillReport fillSolid(Grid& grid, const Scene& scene, const FillOptions& options) {
-  std::vector<OpenBoundary> boundaries;
-  FillReport report = startFill(grid, scene, options, boundaries);
+  std::shared_ptr<const FillWinding> winding;
+  FillReport report = startFill(grid, scene, options, winding);
   report.emptyCells = grid.cellCount() - grid.occupiedCount();
   const RowTable table = buildRows(grid, options.memoryLimitBytes);
   std::vector<uint8_t> enclosed;
@@ -668,17 +683,21 @@ FillReport fillSolid(Grid& grid, const Scene& scene, const FillOptions& options)
     const uint64_t outside = uf.find(0);
     enclosed = enclosedGaps(table, uf, [&](uint64_t root) { return root == outside; });
   }
-  grid.solidRuns = solidRuns(grid, scene, std::move(boundaries), table, enclosed, 0, options, report);
+  grid.solidRuns = solidRuns(grid, winding.get(), table, enclosed, 0, options, report);
   if (options.progress) options.progress(1.0);
   return report;
 }
 
-SlabFill::SlabFill(const Grid& plan, const Scene& scene, const FillOptions& options)
-    : scene_(scene), options_(options) {
+SlabFill::SlabFill(const Grid& plan, const Scene& scene, const FillOptions& options) : options_(options) {
   plan_.bounds = plan.bounds;
   plan_.dims = plan.dims;
   plan_.method = plan.method;
-  report_ = startFill(plan_, scene, options, boundaries_);
+  report_ = startFill(plan_, scene, options, winding_);
+}
+
+const std::vector<uint64_t>& SlabFill::labelsBelow() const {
+  static const std::vector<uint64_t> none;  // the first slab: nothing below
+  return slab_ > 0 ? topLabels_[slab_ - 1] : none;
 }
 
 Grid SlabFill::slabGrid(std::span<const uint64_t> keys, uint32_t k0, uint32_t k1) {
@@ -689,7 +708,7 @@ Grid SlabFill::slabGrid(std::span<const uint64_t> keys, uint32_t k0, uint32_t k1
     fail<Error>("solid fill: a cell of the slab of planes [", k0, ", ", k1, ") lies outside it");
   Grid g = plan_;
   g.cellKeys.reserve(previousPlane_.size() + keys.size());
-  g.cellKeys = previousPlane_;
+  g.cellKeys.assign(previousPlane_.begin(), previousPlane_.end());
   g.cellKeys.insert(g.cellKeys.end(), keys.begin(), keys.end());
   // The slab's top plane is the next slab's plane below.
   previousPlane_.assign(std::lower_bound(keys.begin(), keys.end(), (k1 - 1u) * plane), keys.end());
@@ -710,7 +729,7 @@ FillOptions SlabFill::slabOptions(uint32_t k0, uint32_t k1, bool secondPass) con
 void SlabFill::link(std::span<const uint64_t> keys, uint32_t k0, uint32_t k1) {
   if (filling_) fail<Error>("solid fill: a slab linked after the fill began");
   SlabLinks s = linkSlab(slabGrid(keys, k0, k1), k0, k1, options_.memoryLimitBytes);
-  const std::vector<uint64_t> none, &below = slab_ > 0 ? topLabels_[slab_ - 1] : none;
+  const std::vector<uint64_t>& below = labelsBelow();
   if (s.table.gapBegin[s.firstRow] != below.size())
     fail<Error>("solid fill: the plane below slab [", k0, ", ", k1, ") is not the one linked before");
   UnionFind labels{std::move(labelParent_)};
@@ -754,7 +773,7 @@ std::vector<CellRun> SlabFill::fill(std::span<const uint64_t> keys, uint32_t k0,
   }
   if (slab_ >= topLabels_.size()) fail<Error>("solid fill: more slabs filled than linked");
   SlabLinks s = linkSlab(slabGrid(keys, k0, k1), k0, k1, options_.memoryLimitBytes);
-  const std::vector<uint64_t> none, &below = slab_ > 0 ? topLabels_[slab_ - 1] : none, &top = topLabels_[slab_];
+  const std::vector<uint64_t>&below = labelsBelow(), &top = topLabels_[slab_];
   const uint64_t outside = s.uf.find(0);
   // A component is outside when it reaches the outside within the slab or through a labelled gap of a face plane.
   std::unordered_map<uint64_t, bool> outsideThroughLabel;
@@ -767,8 +786,8 @@ std::vector<CellRun> SlabFill::fill(std::span<const uint64_t> keys, uint32_t k0,
     return it != outsideThroughLabel.end() && it->second;
   });
   report_.emptyCells += (k1 - k0) * uint64_t(plan_.dims[0]) * plan_.dims[1] - keys.size();
-  std::vector<CellRun> runs = solidRuns(s.grid, scene_, std::vector<OpenBoundary>(boundaries_), s.table, enclosed,
-                                        s.firstRow, slabOptions(k0, k1, true), report_);
+  std::vector<CellRun> runs =
+      solidRuns(s.grid, winding_.get(), s.table, enclosed, s.firstRow, slabOptions(k0, k1, true), report_);
   ++slab_;
   if (options_.progress && !slabOptions(k0, k1, true).progress(1.0)) fail<Error>("solid fill cancelled");
   return runs;

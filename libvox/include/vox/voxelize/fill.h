@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -10,7 +11,6 @@
 
 #include "vox/core/grid.h"
 #include "vox/core/scene.h"
-#include "vox/voxelize/open_edges.h"
 
 namespace vox {
 
@@ -70,6 +70,8 @@ FillReport fillSolid(Grid& grid, const Scene& scene, const FillOptions& options 
 // order) decides each slab's runs with the components' final status. Scratch memory is one slab's (fillSolid's for
 // its cells) plus one plane's keys and 8 bytes per gap of every slab's top plane. The solid runs, concatenated and
 // merged where they touch (appendSolidRun), are fillSolid's for the whole grid, run for run.
+struct FillWinding;  // fill.cpp: the winding-number tree and the holes' caps
+
 class SlabFill {
  public:
   // `plan`: bounds, dims and method of the grid (its cells are ignored). Throws LimitError as fillSolid.
@@ -84,11 +86,11 @@ class SlabFill {
  private:
   Grid slabGrid(std::span<const uint64_t> keys, uint32_t k0, uint32_t k1);
   FillOptions slabOptions(uint32_t k0, uint32_t k1, bool secondPass) const;
+  const std::vector<uint64_t>& labelsBelow() const;  // the labels of the gaps of the current slab's plane below
 
   Grid plan_;
-  const Scene& scene_;
   FillOptions options_;
-  std::vector<OpenBoundary> boundaries_;
+  std::shared_ptr<const FillWinding> winding_;  // built once, for every slab; none under the Enclosed rule
   FillReport report_;
   uint32_t nextPlane_ = 0;
   bool filling_ = false;

@@ -643,6 +643,109 @@ TEST(WalkRobustness, ExactCoverageThroughRoundedCorners) {
   }
 }
 
+// The cells of a walk by next(), or by walk() stopped after `stopAfter` cells (0: never).
+std::vector<WalkCell> cellsByNext(const Accel& accel, const Ray& ray, EmptySkip skip, uint64_t& steps) {
+  GridWalker w(accel, ray, skip);
+  std::vector<WalkCell> cells;
+  WalkCell c;
+  while (w.next(c)) cells.push_back(c);
+  steps = w.stepsTaken();
+  return cells;
+}
+std::vector<WalkCell> cellsByWalk(const Accel& accel, const Ray& ray, EmptySkip skip, size_t stopAfter,
+                                  uint64_t& steps) {
+  GridWalker w(accel, ray, skip);
+  std::vector<WalkCell> cells;
+  w.walk([&](const WalkCell& c) {
+    cells.push_back(c);
+    return cells.size() == stopAfter;
+  });
+  steps = w.stepsTaken();
+  return cells;
+}
+
+bool sameCell(const WalkCell& a, const WalkCell& b) {
+  return a.idx == b.idx && std::memcmp(&a.tEnter, &b.tEnter, sizeof(double)) == 0 &&
+         std::memcmp(&a.tExit, &b.tExit, sizeof(double)) == 0 &&
+         std::memcmp(&a.exitSlack, &b.exitSlack, sizeof(double)) == 0 && a.entryAxis == b.entryAxis &&
+         a.extra == b.extra;
+}
+
+// walk() (the register walk of traceRay and occluded, issue 12) must report exactly the cells of next(), in order,
+// field for field, bit for bit, with and without its stop: on rays through the rounded corners and along the edges of
+// a 300^3 grid (extra cells), random rays starting inside and outside, with a short tMax, and through block tables
+// with empty blocks and empty boxes of blocks, both ways of skipping them.
+TEST(WalkRobustness, WalkEqualsNext) {
+  Grid g;
+  g.bounds = Box{{0.1, 0.3, -0.7}, {0.8, 1.0, 0.3}};
+  g.dims = {300, 300, 300};
+  std::mt19937 rng(29);
+  std::uniform_int_distribution<int> idx(0, 300);
+  std::uniform_real_distribution<double> u(-1, 1);
+  auto corner = [&](int i, int j, int k) {
+    return Vec3{cellBoundary(g.bounds, g.dims, 0, i), cellBoundary(g.bounds, g.dims, 1, j),
+                cellBoundary(g.bounds, g.dims, 2, k)};
+  };
+  std::vector<Ray> rays = {Ray{corner(0, 0, 0), corner(300, 300, 300) - corner(0, 0, 0)},
+                           Ray{corner(300, 300, 300), corner(0, 0, 0) - corner(300, 300, 300)},
+                           Ray{corner(0, 300, 0), corner(300, 0, 300) - corner(0, 300, 0)}};
+  for (int r = 0; r < 60; ++r) {
+    const Vec3 a = corner(idx(rng), idx(rng), idx(rng)), b = corner(idx(rng) / 4 * 4, idx(rng), idx(rng));
+    if (a.x == b.x || a.y == b.y || a.z == b.z) continue;
+    rays.push_back(Ray{a - (b - a) * 2.0, b - a});
+    rays.push_back(Ray{a, b - a});
+    rays.push_back(Ray{a, b - a, 0, 0.3});  // ends inside the grid
+  }
+  for (int r = 0; r < 200; ++r) {
+    const Vec3 o{0.45 + 0.6 * u(rng), 0.65 + 0.6 * u(rng), -0.2 + 0.8 * u(rng)};
+    rays.push_back(Ray{o, Vec3{u(rng), u(rng), u(rng)}, r % 3 == 0 ? 0.1 : 0, r % 4 == 0 ? 0.5 : kInfinity});
+  }
+  rays.push_back(Ray{corner(10, 20, 30), Vec3{1, 0, 1}});  // a zero component: next() itself
+
+  Accel accel;
+  accel.grid = &g;
+  accel.blockShift = 2;
+  for (int a = 0; a < 3; ++a) accel.blockDims[a] = (g.dims[a] + 3) >> 2;
+  accel.blockSlot.resize(size_t(accel.blockDims[0]) * accel.blockDims[1] * accel.blockDims[2]);
+  accel.boundaries = makeCellBoundaries(g.bounds, g.dims);
+  size_t extras = 0, jumps = 0, compared = 0;
+  for (int sparsity : {1, 5, 40}) {  // 1: no block tables at all
+    for (uint32_t& slot : accel.blockSlot) slot = sparsity > 1 && rng() % sparsity != 0 ? kEmptyCell : 0;
+    if (sparsity == 1) accel.blockShift = 0;
+    for (bool boxes : {false, true}) {
+      accel.emptyShift.clear();
+      if (accel.blockShift != 0 && boxes) buildEmptyShift(accel);
+      for (EmptySkip skip : {EmptySkip::Blocks, EmptySkip::Boxes}) {
+        for (size_t r = 0; r < rays.size(); ++r) {
+          const std::string what = "sparsity " + std::to_string(sparsity) + (boxes ? " boxes" : "") +
+                                   (skip == EmptySkip::Boxes ? " skip boxes" : "") + ", ray " + std::to_string(r);
+          uint64_t stepsNext = 0, stepsWalk = 0, unused = 0;
+          const std::vector<WalkCell> expected = cellsByNext(accel, rays[r], skip, stepsNext);
+          const std::vector<WalkCell> got = cellsByWalk(accel, rays[r], skip, 0, stepsWalk);
+          ASSERT_EQ(got.size(), expected.size()) << what;
+          for (size_t i = 0; i < got.size(); ++i) {
+            ASSERT_TRUE(sameCell(got[i], expected[i])) << what << ", cell " << i;
+            extras += got[i].extra;
+          }
+          ASSERT_EQ(stepsWalk, stepsNext) << what;
+          jumps += stepsNext > got.size();
+          ++compared;
+          for (size_t stop : {size_t(1), size_t(3)}) {
+            const std::vector<WalkCell> head = cellsByWalk(accel, rays[r], skip, stop, unused);
+            ASSERT_EQ(head.size(), std::min(stop, expected.size())) << what;
+            for (size_t i = 0; i < head.size(); ++i) ASSERT_TRUE(sameCell(head[i], expected[i])) << what;
+          }
+        }
+      }
+    }
+    accel.blockShift = 2;
+  }
+  // The cases must occur, or the comparison proves little.
+  EXPECT_GT(extras, 100u);
+  EXPECT_GT(jumps, 100u);
+  EXPECT_EQ(compared, 3 * 2 * 2 * rays.size());
+}
+
 TEST(GridVsBruteForce, NearCoincidentHitsOnBothSidesOfABoundary) {
   // See testing::nearCoincidentPlanes: the nearest hit is often B, one ulp beyond the cell face holding A.
   std::mt19937 rng(23);

@@ -291,10 +291,10 @@ inline bool walkCells(const Accel& accel, const Ray& ray, Hit& best, TraceStats&
   filter::FilterRay filterRay;
   const filter::FilterRay* fr = filter::prepareFilterRay(accel.floatCells, ray, filterRay) ? &filterRay : nullptr;
   const bool direct = directGroups(accel, fr);
-  GridWalker walker(accel, ray);
+  GridWalker walker(accel, ray, EmptySkip::Boxes);
   Mailbox<64> mailbox;
-  WalkCell cell;
-  while (walker.next(cell)) {
+  bool anyHit = false;
+  walker.walk([&](const WalkCell& cell) {
     ++st.cells;
     bool hit = false;
     if (direct) {
@@ -305,14 +305,14 @@ inline bool walkCells(const Accel& accel, const Ray& ray, Hit& best, TraceStats&
       if (c < kSolidCell) hit = testCell<AnyHit>(accel, c, ray, fr, mailbox, best, st);
     }
     if (AnyHit) {
-      if (hit) return true;
-      continue;
+      anyHit = hit;
+      return hit;
     }
     // A hit may lie beyond this cell (a primitive spanning cells): it is kept, and accepted only once the walk
     // has passed every cell that could hold a nearer one.
-    if (best.valid() && best.t + walker.hitSlack(best.t) < cell.tExit - cell.exitSlack) break;
-  }
-  return false;
+    return best.valid() && best.t + walker.hitSlack(best.t) < cell.tExit - cell.exitSlack;
+  });
+  return anyHit;
 }
 
 // The walks compiled twice, for AVX2 (VEX-encoded float filter and setup, SSE4.1) and for the baseline, and picked at

@@ -65,6 +65,9 @@ struct RayAxes {
 };
 RayAxes rayAxes(const CellBoundaries& cells, const Ray& ray);
 
+// Which empty space the walk of an Accel jumps over (GridWalker::fastForward).
+enum class EmptySkip : uint8_t { Blocks, Boxes };
+
 struct WalkCell {
   std::array<uint32_t, 3> idx;
   double tEnter = 0, tExit = 0;
@@ -84,11 +87,15 @@ class GridWalker {
   // two-level table (Accel::blockSlot) in one jump each, or of the largest empty aligned box of blocks holding one
   // (Accel::emptyShift; see fastForward); cells in empty blocks may therefore not be reported. `accel` must outlive
   // the walker.
-  GridWalker(const Accel& accel, const Ray& ray) {
+  // With EmptySkip::Boxes only boxes of two or more blocks a side are jumped over (Accel::emptyShift above
+  // blockShift; nothing without emptyShift): the walk of traceRay and occluded, whose steps cost less than a jump's
+  // setup over a single block (issue 12).
+  GridWalker(const Accel& accel, const Ray& ray, EmptySkip skip = EmptySkip::Blocks) {
     init(accel.boundaries, ray);
     if (accel.blockShift != 0 && !done_) {
       blockSlot_ = accel.blockSlot.data();
       shift_ = accel.blockShift;
+      minSkip_ = skip == EmptySkip::Boxes ? accel.blockShift : 0;
       blockDims_[0] = accel.blockDims[0];
       blockDims_[1] = accel.blockDims[1];
       emptyShift_ = accel.emptyShift.empty() ? nullptr : accel.emptyShift.data();
@@ -111,12 +118,8 @@ class GridWalker {
     if (done_) return false;
     if (checkBlock_) [[unlikely]] {
       checkBlock_ = false;
-      if (emptyShift_ != nullptr) {
-        const uint32_t skip = emptyShift_[blockIndex()];
-        if (skip != 0) fastForward(skip);
-      } else if (blockEmpty()) {
-        fastForward(shift_);
-      }
+      const uint32_t skip = skipShift();
+      if (skip != 0) fastForward(skip);
     }
     out.idx = {uint32_t(idx_[0]), uint32_t(idx_[1]), uint32_t(idx_[2])};
     out.tEnter = tCur_;
@@ -137,6 +140,14 @@ class GridWalker {
     return true;
   }
 
+  // The cells of repeated next() calls, the same ones in the same order with the same fields, passed to
+  // `visit(const WalkCell&)`, which returns true to end the walk. The walk of traceRay and occluded (issue 12): the
+  // state of the steps stays in registers, the stepped axis is a branch (predicted, so one step does not wait on the
+  // comparisons of the last), and each axis's crossing after its next one is computed a step ahead, so that a step
+  // only moves values. Rays with a component whose inverse is not a normal number (zero or tiny) take next().
+  template <class Visit>
+  void walk(Visit&& visit);
+
   // Bound on the error of a primitive hit's t at parameter t (ray units), used to decide when the walk may stop.
   double hitSlack(double t) const { return ax_.hitSlackAt(t); }
   uint64_t stepsTaken() const { return steps_; }
@@ -150,13 +161,34 @@ class GridWalker {
     const double b = bnd_[a][idx_[a] + (step_[a] > 0 ? 1 : 0)];
     return ax_.crossing(a, b, org_[a], dir_[a]);
   }
-  // Is the ray, at parameter tm, within tolerance of axis a's next boundary?
-  // Both conditions evaluated (no short circuit): the second is harmless for an infinite tNext_ and the branch
-  // would be mispredicted.
-  bool near(int a, double tm) const {
-    return std::isfinite(tNext_[a]) &
-           ((tNext_[a] - tm) * std::fabs(dir_[a]) <= ax_.tolPos[a] + kRel * std::fabs(tm * dir_[a]));
+  // Is the ray, at parameter tm, within tolerance of axis a's next boundary? Compared in ray parameter units (tol[a]
+  // is tolPos[a] / |d_a|; the same bound as tolPos[a] in world units but for a few ulps of it). An infinite tNext is
+  // never near: inf - tm exceeds any finite bound, and is NaN when tm is infinite too.
+  bool near(int a, double tm) const { return nearAt(a, tNext_[a], tm, kRel * std::fabs(tm)); }
+  bool nearAt(int a, double tNext, double tm, double relSlack) const { return tNext - tm <= ax_.tol[a] + relSlack; }
+  // The crossing of axis a's boundary after the next one, from cell index i (nonzero step): the value nextT(a) takes
+  // after the next step on a. The index is clamped into the table; where that changes it, that step leaves the grid
+  // and the value is never used.
+  double afterT(int a, int64_t i) const {
+    const int64_t j = std::clamp<int64_t>(i + step_[a] + (step_[a] > 0 ? 1 : 0), 0, int64_t(dims_[a]));
+    return ax_.crossing(a, bnd_[a][j], org_[a], dir_[a]);
   }
+  // walk()'s copy of the state of the steps, in registers; `after` holds afterT of each axis.
+  struct WalkState {
+    int64_t idx[3];
+    double t[3], after[3];
+    double tCur;
+    int entryAxis;
+    uint64_t steps;
+    bool checkBlock;
+  };
+  void saveState(const WalkState& w);
+  void loadState(WalkState& w) const;
+  // One step of walk() on axis M at parameter tm from `cell` (step() and next() in one); false when the walk ends.
+  template <int M, class Visit>
+  bool walkStep(Visit& visit, double tm, WalkCell& cell, WalkState& w);
+  template <class Visit>
+  bool visitExtras(Visit& visit, int m, double tm, const WalkCell& cell, const WalkState& w, bool n1, bool n2);
 
   void step(int m, double tm, const WalkCell& from) {
     if (!(tm <= tHi_ + ax_.tol[m] + kRel * std::fabs(tm)) || ++steps_ > maxSteps_) {
@@ -186,6 +218,11 @@ class GridWalker {
     return bx + blockDims_[0] * (by + blockDims_[1] * bz);
   }
   bool blockEmpty() const { return blockSlot_[blockIndex()] == kEmptyCell; }
+  // On entering a block: the shift of the empty box to jump over (see fastForward), or 0 to walk on.
+  uint32_t skipShift() const {
+    const uint32_t skip = emptyShift_ != nullptr ? emptyShift_[blockIndex()] : blockEmpty() ? shift_ : 0;
+    return skip > minSkip_ ? skip : 0;
+  }
   void fastForward(uint32_t shift);
 
   std::unique_ptr<CellBoundaries> owned_;  // the tables, when the walker built them itself
@@ -208,7 +245,102 @@ class GridWalker {
   uint64_t blockDims_[2] = {0, 0};
   const uint8_t* emptyShift_ = nullptr;  // Accel::emptyShift, when built
   bool checkBlock_ = false;
+  uint32_t minSkip_ = 0;  // boxes of 2^minSkip_ cells a side or smaller are walked (EmptySkip)
 };
+
+template <int M, class Visit>
+inline bool GridWalker::walkStep(Visit& visit, double tm, WalkCell& cell, WalkState& w) {
+  const double relSlack = kRel * std::fabs(tm);
+  cell.tExit = tm;
+  cell.exitSlack = ax_.tol[M] + relSlack;
+  if (visit(static_cast<const WalkCell&>(cell))) return false;
+  if (!(tm <= tHi_ + ax_.tol[M] + relSlack) || ++w.steps > maxSteps_) return false;
+  constexpr int A1 = M == 0, A2 = 2 - (M == 2);
+  const bool n1 = nearAt(A1, w.t[A1], tm, relSlack), n2 = nearAt(A2, w.t[A2], tm, relSlack);
+  if (n1 | n2) [[unlikely]]
+    if (!visitExtras(visit, M, tm, cell, w, n1, n2)) return false;
+  w.idx[M] += step_[M];
+  if (uint64_t(w.idx[M]) >= dims_[M]) return false;
+  w.checkBlock = (blockSlot_ != nullptr) & ((w.idx[M] & blockMask()) == (step_[M] > 0 ? 0 : blockMask()));
+  w.tCur = tm;
+  w.entryAxis = M;
+  w.t[M] = w.after[M];
+  w.after[M] = afterT(M, w.idx[M]);
+  return true;
+}
+
+// The rare paths of walk() go through the members and next()'s own functions.
+inline void GridWalker::saveState(const WalkState& w) {
+  for (int a = 0; a < 3; ++a) {
+    idx_[a] = w.idx[a];
+    tNext_[a] = w.t[a];
+  }
+  tCur_ = w.tCur;
+  entryAxis_ = w.entryAxis;
+  steps_ = w.steps;
+}
+inline void GridWalker::loadState(WalkState& w) const {
+  for (int a = 0; a < 3; ++a) {
+    w.idx[a] = idx_[a];
+    w.t[a] = tNext_[a];
+    w.after[a] = afterT(a, idx_[a]);
+  }
+  w.tCur = tCur_;
+  w.entryAxis = entryAxis_;
+  w.steps = steps_;
+}
+
+template <class Visit>
+inline bool GridWalker::visitExtras(Visit& visit, int m, double tm, const WalkCell& cell, const WalkState& w, bool n1,
+                                    bool n2) {
+  saveState(w);
+  const WalkCell from = cell;  // a copy, so that `cell` itself never escapes the registers
+  queueExtras(m, tm, from, n1, n2);
+  while (queued_ > 0)
+    if (visit(static_cast<const WalkCell&>(queue_[--queued_]))) return false;
+  return true;
+}
+
+template <class Visit>
+inline void GridWalker::walk(Visit&& visit) {
+  WalkCell cell;
+  if (done_ || queued_ > 0 || ax_.divide[0] || ax_.divide[1] || ax_.divide[2]) {
+    while (next(cell))
+      if (visit(static_cast<const WalkCell&>(cell))) return;
+    return;
+  }
+  WalkState w;
+  loadState(w);
+  w.checkBlock = checkBlock_;
+  cell.extra = false;
+  for (;;) {
+    if (w.checkBlock) [[unlikely]] {
+      w.checkBlock = false;
+      saveState(w);
+      const uint32_t skip = skipShift();
+      if (skip != 0) {
+        fastForward(skip);
+        loadState(w);
+      }
+    }
+    cell.idx = {uint32_t(w.idx[0]), uint32_t(w.idx[1]), uint32_t(w.idx[2])};
+    cell.tEnter = w.tCur;
+    cell.entryAxis = w.entryAxis;
+    // The axis of the nearest next boundary, first of equals (as next()).
+    const bool b01 = w.t[1] < w.t[0];
+    const double t01 = b01 ? w.t[1] : w.t[0];
+    bool more;
+    if (w.t[2] < t01)
+      more = walkStep<2>(visit, w.t[2], cell, w);
+    else if (b01)
+      more = walkStep<1>(visit, w.t[1], cell, w);
+    else
+      more = walkStep<0>(visit, w.t[0], cell, w);
+    if (!more) break;
+  }
+  saveState(w);
+  done_ = true;
+}
 
 // Counters of one thread's tracing; summed over threads for --stats.
 struct TraceStats {

@@ -315,16 +315,17 @@ inline bool walkCells(const Accel& accel, const Ray& ray, Hit& best, TraceStats&
   return anyHit;
 }
 
-// The walks compiled twice, for AVX2 (VEX-encoded float filter and setup, SSE4.1) and for the baseline, and picked at
-// load time like the packet kernel; `flatten` puts the walker, the filter and the setup into each copy. The
-// arithmetic is IEEE either way: no FMA is enabled (the "avx2" target does not imply it, and -ffp-contract=off forbids
-// contraction), so both copies visit the same cells and get the same t. intersect.cpp's tests are called out of line,
-// the same code for both. clang refuses `flatten` on a multiversioned function (its fuzz build gets the clones
-// with their usual inlining).
+// The walks compiled three times, for x86-64-v4 (AVX-512: 32 vector registers, so the walk's state and the float
+// filter's rows spill less), AVX2 (VEX-encoded float filter and setup, SSE4.1) and the baseline, and picked at load
+// time like the packet kernel; `flatten` puts the walker, the filter and the setup into each copy. The arithmetic is
+// IEEE in every copy: -ffp-contract=off forbids contracting a * b + c into a fused multiply-add even where the target
+// has one (x86-64-v4; tests/cli/no_fused_multiply_add.sh checks the library holds none), so all copies visit the same
+// cells and get the same t. intersect.cpp's tests are called out of line, the same code for all. clang refuses
+// `flatten` on a multiversioned function (its fuzz build gets two clones with their usual inlining).
 #if defined(__clang__)
 #define VOX_WALK_COPIES [[gnu::target_clones("avx2", "default")]]
 #else
-#define VOX_WALK_COPIES [[gnu::target_clones("avx2", "default"), gnu::flatten]]
+#define VOX_WALK_COPIES [[gnu::target_clones("arch=x86-64-v4", "avx2", "default"), gnu::flatten]]
 #endif
 VOX_WALK_COPIES void walkNearest(const Accel& accel, const Ray& ray, Hit& best, TraceStats& st) {
   walkCells<false>(accel, ray, best, st);

@@ -580,17 +580,35 @@ void expectExactCoverage(const Grid& g, const Ray& ray, const std::string& what,
         }
 }
 
-TEST(WalkRobustness, ExactCoverageThroughRoundedCorners) {
+// A 300^3 grid whose boundaries are rounded (none of them is a short binary fraction), and the corner (i, j, k).
+Grid roundedGrid300() {
   Grid g;
   g.bounds = Box{{0.1, 0.3, -0.7}, {0.8, 1.0, 0.3}};
   g.dims = {300, 300, 300};
+  return g;
+}
+Vec3 gridCorner(const Grid& g, int i, int j, int k) {
+  return Vec3{cellBoundary(g.bounds, g.dims, 0, i), cellBoundary(g.bounds, g.dims, 1, j),
+              cellBoundary(g.bounds, g.dims, 2, k)};
+}
+// An Accel over `g` with only boundary tables and 4^3 block tables (all blocks occupied until the caller empties
+// some): enough for walks that skip empty blocks, which only look at emptiness.
+Accel blockTablesOnly(const Grid& g) {
+  Accel accel;
+  accel.grid = &g;
+  accel.blockShift = 2;
+  for (int a = 0; a < 3; ++a) accel.blockDims[a] = (g.dims[a] + 3) >> 2;
+  accel.blockSlot.assign(size_t(accel.blockDims[0]) * accel.blockDims[1] * accel.blockDims[2], 0);
+  accel.boundaries = makeCellBoundaries(g.bounds, g.dims);
+  return accel;
+}
+
+TEST(WalkRobustness, ExactCoverageThroughRoundedCorners) {
+  const Grid g = roundedGrid300();
   std::mt19937 rng(17);
   std::uniform_int_distribution<int> idx(0, 300);
   int rays = 0;
-  auto corner = [&](int i, int j, int k) {
-    return Vec3{cellBoundary(g.bounds, g.dims, 0, i), cellBoundary(g.bounds, g.dims, 1, j),
-                cellBoundary(g.bounds, g.dims, 2, k)};
-  };
+  auto corner = [&](int i, int j, int k) { return gridCorner(g, i, j, k); };
   // Main diagonals (through every rounded corner (i, i, i)), both ways, and random corner-to-corner rays.
   std::vector<Ray> list = {Ray{corner(0, 0, 0), corner(300, 300, 300) - corner(0, 0, 0)},
                            Ray{corner(300, 300, 300), corner(0, 0, 0) - corner(300, 300, 300)},
@@ -613,13 +631,8 @@ TEST(WalkRobustness, ExactCoverageThroughRoundedCorners) {
   // The same rays through a grid where most 4x4x4 blocks are empty: the walk that jumps over empty blocks must still
   // visit every cell of the other blocks that the exact ray meets (it fails when the jump ignores the block's edges
   // and corners or lands on the exit boundary itself).
-  Accel sparse;
-  sparse.grid = &g;
-  sparse.blockShift = 2;
-  for (int a = 0; a < 3; ++a) sparse.blockDims[a] = (g.dims[a] + 3) >> 2;
-  sparse.blockSlot.resize(size_t(sparse.blockDims[0]) * sparse.blockDims[1] * sparse.blockDims[2]);
+  Accel sparse = blockTablesOnly(g);
   for (uint32_t& slot : sparse.blockSlot) slot = rng() % 5 == 0 ? 0 : kEmptyCell;  // only emptiness matters here
-  sparse.boundaries = makeCellBoundaries(g.bounds, g.dims);
   rays = 0;
   for (const Ray& ray : list) expectExactCoverage(g, ray, "sparse ray " + std::to_string(rays++), &sparse);
 
@@ -676,16 +689,11 @@ bool sameCell(const WalkCell& a, const WalkCell& b) {
 // a 300^3 grid (extra cells), random rays starting inside and outside, with a short tMax, and through block tables
 // with empty blocks and empty boxes of blocks, both ways of skipping them.
 TEST(WalkRobustness, WalkEqualsNext) {
-  Grid g;
-  g.bounds = Box{{0.1, 0.3, -0.7}, {0.8, 1.0, 0.3}};
-  g.dims = {300, 300, 300};
+  const Grid g = roundedGrid300();
   std::mt19937 rng(29);
   std::uniform_int_distribution<int> idx(0, 300);
   std::uniform_real_distribution<double> u(-1, 1);
-  auto corner = [&](int i, int j, int k) {
-    return Vec3{cellBoundary(g.bounds, g.dims, 0, i), cellBoundary(g.bounds, g.dims, 1, j),
-                cellBoundary(g.bounds, g.dims, 2, k)};
-  };
+  auto corner = [&](int i, int j, int k) { return gridCorner(g, i, j, k); };
   std::vector<Ray> rays = {Ray{corner(0, 0, 0), corner(300, 300, 300) - corner(0, 0, 0)},
                            Ray{corner(300, 300, 300), corner(0, 0, 0) - corner(300, 300, 300)},
                            Ray{corner(0, 300, 0), corner(300, 0, 300) - corner(0, 300, 0)}};
@@ -702,12 +710,7 @@ TEST(WalkRobustness, WalkEqualsNext) {
   }
   rays.push_back(Ray{corner(10, 20, 30), Vec3{1, 0, 1}});  // a zero component: next() itself
 
-  Accel accel;
-  accel.grid = &g;
-  accel.blockShift = 2;
-  for (int a = 0; a < 3; ++a) accel.blockDims[a] = (g.dims[a] + 3) >> 2;
-  accel.blockSlot.resize(size_t(accel.blockDims[0]) * accel.blockDims[1] * accel.blockDims[2]);
-  accel.boundaries = makeCellBoundaries(g.bounds, g.dims);
+  Accel accel = blockTablesOnly(g);
   size_t extras = 0, jumps = 0, compared = 0;
   for (int sparsity : {1, 5, 40}) {  // 1: no block tables at all
     for (uint32_t& slot : accel.blockSlot) slot = sparsity > 1 && rng() % sparsity != 0 ? kEmptyCell : 0;

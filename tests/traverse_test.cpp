@@ -749,6 +749,55 @@ TEST(WalkRobustness, WalkEqualsNext) {
   EXPECT_EQ(compared, 3 * 2 * 2 * rays.size());
 }
 
+// The start cell of a walk from inside the grid is, on each axis, the cell its definition names (docs/trace.md, The
+// walk, step 2): up the axis the last cell whose lower boundary is at most p - tol, down it the first whose upper
+// boundary is at least p + tol, along it the cell below p, with tol = positionTolerance. Origins on boundaries, one
+// ulp and one tolerance off them, with every sign of every component.
+TEST(WalkRobustness, StartCellIsTheCellItsDefinitionNames) {
+  const Grid g = roundedGrid300();
+  const CellBoundaries cb = makeCellBoundaries(g.bounds, g.dims);
+  const int64_t n = 300;
+  std::mt19937 rng(31);
+  std::uniform_int_distribution<int> boundary(1, 299);
+  const double components[] = {1, -1, 0, -0.0, 0.3, -0.7, 1e-30};
+  auto expectedIndex = [&](int a, double p, double d) {
+    const std::vector<double>& b = cb.b[a];
+    const double tol = positionTolerance(cb, a, p);
+    if (d < 0) {
+      for (int64_t i = 0; i < n; ++i)
+        if (b[i + 1] >= p + tol) return i;
+      return n - 1;
+    }
+    const double c = d > 0 ? p - tol : p;
+    int64_t found = 0;
+    for (int64_t i = 0; i < n; ++i)
+      if (b[i] <= c) found = i;
+    return found;
+  };
+  int checked = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    double oa[3];
+    for (int a = 0; a < 3; ++a) {
+      const double b = cb.b[a][boundary(rng)];
+      const double tol = positionTolerance(cb, a, b);
+      const double choices[] = {b,       std::nextafter(b, -1e9), std::nextafter(b, 1e9), b - tol,
+                                b + tol, b + 0.5 * cb.cellSize[a]};
+      oa[a] = choices[rng() % 6];
+    }
+    const Vec3 o{oa[0], oa[1], oa[2]};
+    const Vec3 d{components[rng() % 7], components[rng() % 7], components[rng() % 7]};
+    if (d.x == 0 && d.y == 0 && d.z == 0) continue;
+    GridWalker w(g.bounds, g.dims, Ray{o, d});
+    WalkCell cell;
+    ASSERT_TRUE(w.next(cell)) << trial;
+    for (int a = 0; a < 3; ++a)
+      ASSERT_EQ(int64_t(cell.idx[a]), expectedIndex(a, o[a], d[a]))
+          << "trial " << trial << " axis " << a << " origin " << o[a] << " direction " << d[a];
+    ++checked;
+  }
+  EXPECT_GT(checked, 350);
+}
+
 TEST(GridVsBruteForce, NearCoincidentHitsOnBothSidesOfABoundary) {
   // See testing::nearCoincidentPlanes: the nearest hit is often B, one ulp beyond the cell face holding A.
   std::mt19937 rng(23);

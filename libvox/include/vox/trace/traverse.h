@@ -190,8 +190,15 @@ class GridWalker {
   template <class Visit>
   bool visitExtras(Visit& visit, int m, double tm, const WalkCell& cell, const WalkState& w, bool n1, bool n2);
 
+  // Shared by step() and walkStep(), which must agree bit for bit: is the boundary at tm (on axis m, relSlack =
+  // kRel |tm|) past the end of the walk, and does index i, just stepped to on axis m, start a new block?
+  bool pastEnd(int m, double tm, double relSlack) const { return !(tm <= tHi_ + ax_.tol[m] + relSlack); }
+  bool entersBlock(int m, int64_t i) const {
+    return (blockSlot_ != nullptr) & ((i & blockMask()) == (step_[m] > 0 ? 0 : blockMask()));
+  }
+
   void step(int m, double tm, const WalkCell& from) {
-    if (!(tm <= tHi_ + ax_.tol[m] + kRel * std::fabs(tm)) || ++steps_ > maxSteps_) {
+    if (pastEnd(m, tm, kRel * std::fabs(tm)) || ++steps_ > maxSteps_) {
       done_ = true;
       return;
     }
@@ -206,7 +213,7 @@ class GridWalker {
       return;
     }
     // Entering a new block: look whether it is empty before reporting its first cell.
-    checkBlock_ = (blockSlot_ != nullptr) & ((idx_[m] & blockMask()) == (step_[m] > 0 ? 0 : blockMask()));
+    checkBlock_ = entersBlock(m, idx_[m]);
     tCur_ = tm;
     entryAxis_ = m;
     tNext_[m] = nextT(m);
@@ -254,14 +261,14 @@ inline bool GridWalker::walkStep(Visit& visit, double tm, WalkCell& cell, WalkSt
   cell.tExit = tm;
   cell.exitSlack = ax_.tol[M] + relSlack;
   if (visit(static_cast<const WalkCell&>(cell))) return false;
-  if (!(tm <= tHi_ + ax_.tol[M] + relSlack) || ++w.steps > maxSteps_) return false;
+  if (pastEnd(M, tm, relSlack) || ++w.steps > maxSteps_) return false;
   constexpr int A1 = M == 0, A2 = 2 - (M == 2);
   const bool n1 = nearAt(A1, w.t[A1], tm, relSlack), n2 = nearAt(A2, w.t[A2], tm, relSlack);
   if (n1 | n2) [[unlikely]]
     if (!visitExtras(visit, M, tm, cell, w, n1, n2)) return false;
   w.idx[M] += step_[M];
   if (uint64_t(w.idx[M]) >= dims_[M]) return false;
-  w.checkBlock = (blockSlot_ != nullptr) & ((w.idx[M] & blockMask()) == (step_[M] > 0 ? 0 : blockMask()));
+  w.checkBlock = entersBlock(M, w.idx[M]);
   w.tCur = tm;
   w.entryAxis = M;
   w.t[M] = w.after[M];

@@ -6,6 +6,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:-$root/build}
 shift || true
 "$root/scripts/build.sh" "$build" -DVOX_TESTS=ON "$@"
+echo "test.sh: $build built at $SECONDS s" >&2
 cd "$build"
 # VOX_CTEST_EXCLUDE: a regular expression of tests to leave out (CI's sanitizer pass leaves out the external clients,
 # whose files the release pass already checked).

@@ -15,7 +15,7 @@ set -euo pipefail
 BIN=$(cd "$1" && pwd)
 shift
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
-MESH=${MESH:-$ROOT/../shared/seed-scenes/meshes/bun_zipper.ply}
+MESH=${MESH:-${VOX_SEED_DIR:-$ROOT/../shared/seed-scenes}/meshes/bun_zipper.ply}
 OUT=${OUT:-/tmp/vox_bench_set}
 mkdir -p "$OUT"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
@@ -42,9 +42,9 @@ make_batch() {  # make_batch N: N OBJ files, each a seed mesh under a random rot
   local n=$1
   [ -f "$OUT/batch_$n/list.txt" ] && return
   mkdir -p "$OUT/batch_$n"
-  python3 - "$ROOT" "$OUT/batch_$n" "$n" <<'PY'
+  python3 - "$ROOT" "$OUT/batch_$n" "$n" "${VOX_SEED_DIR:-$ROOT/../shared/seed-scenes}" <<'PY'
 import math, random, sys, os
-root, out, n = sys.argv[1], sys.argv[2], int(sys.argv[3])
+root, out, n, seed = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4]
 def load(path):
     vs, fs = [], []
     for line in open(path):
@@ -54,7 +54,7 @@ def load(path):
         elif p[0] == 'f': fs.append([int(x.split('/')[0]) for x in p[1:]])
     return vs, fs
 meshes = [load(os.path.join(root, 'scenes', m)) for m in ('bunny_1k.obj', 'teapot.obj', 'cube.obj')]
-meshes.append(load(os.path.join(root, '..', 'shared', 'seed-scenes', 'meshes', 'spot.obj')))
+meshes.append(load(os.path.join(seed, 'meshes', 'spot.obj')))
 rng = random.Random(13)
 with open(os.path.join(out, 'list.txt'), 'w') as lst:
     for i in range(n):

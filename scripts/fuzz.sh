@@ -35,9 +35,10 @@ seed() {  # seed TARGET FILE...
   return 0
 }
 shopt -s nullglob
-course_seeds=("$root"/scenes/*.txt "$root"/../shared/seed-scenes/6837/scenes/*.txt)
+seed_dir=${VOX_SEED_DIR:-$root/../shared/seed-scenes}
+course_seeds=("$root"/scenes/*.txt "$seed_dir"/6837/scenes/*.txt)
 seed course "${course_seeds[@]}"
-seed obj "$root"/scenes/*.obj "$root"/tests/data/*.obj "$root"/../shared/seed-scenes/6837/scenes/*.obj
+seed obj "$root"/scenes/*.obj "$root"/tests/data/*.obj "$seed_dir"/6837/scenes/*.obj
 
 # Small made files: a course scene with every primitive kind, an OBJ with polygons, negative indices and a .mtl
 # reference, ASCII PLYs with float and double properties, a glTF with its buffer in a data URI; then grids of them

@@ -54,7 +54,7 @@ echo "small-merged-off $mesh" >>"$list"
 
 # Course scenes at their handout grids (scenes without a -grid line: 10 10 10), material colours (one colour per
 # object, so the largest rectangles and the most vertices on their sides), and the 40k bunny finer.
-seed=$src/../shared/seed-scenes/6837/scenes
+seed=${VOX_SEED_DIR:-$src/../shared/seed-scenes}/6837/scenes
 # CI runs every test twice, the second time under sanitizers: the course scenes (about 80 MeshLab runs) once.
 sanitized=$(grep -s '^VOX_SANITIZE:BOOL=ON' "$build/CMakeCache.txt")
 if [ -n "$sanitized" ]; then

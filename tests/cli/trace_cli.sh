@@ -5,7 +5,7 @@
 set -u
 BUILD=$1
 SRC=$2
-SEED="$SRC/../shared/seed-scenes/6837/scenes"
+SEED="${VOX_SEED_DIR:-$SRC/../shared/seed-scenes}/6837/scenes"
 TRACE="$BUILD/vox-trace"
 VOXELIZE="$BUILD/vox-voxelize"
 WORK=$(mktemp -d)

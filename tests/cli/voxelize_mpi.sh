@@ -90,7 +90,7 @@ fill_case() {  # fill_case TAG SCENE "ARGS" "BRICKS" "RANK COUNTS"
   done
 }
 fill_case fbunny "$S/scene5_07_bunny_mesh_1k.txt" "--grid 15 15 12" "3 2 2" "$SOME_K"
-fill_case fopen "$SRC/../shared/seed-scenes/meshes/bun_zipper.ply" "--res 20" "7 5 3" "2"
+fill_case fopen "${VOX_SEED_DIR:-$SRC/../shared/seed-scenes}/meshes/bun_zipper.ply" "--res 20" "7 5 3" "2"
 
 # A failing rank: one brick cannot be written (a folder in its place). The run fails with that message, exit 3, on
 # every rank count, and no manifest is written.

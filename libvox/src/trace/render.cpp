@@ -196,6 +196,74 @@ struct Renderer {
     }
   }
 
+  // Blocks of kBlock x kBlock pixels: each sample index of a block is one packet of primary rays.
+  static constexpr uint32_t kBlock = 8;
+  static_assert(kBlock * kBlock <= kMaxPacketRays);
+
+  // Where sample s of pixel (x, y) lies: the centre for one sample, else jittered in its stratum of a sqrt(samples)
+  // square grid, or anywhere in the pixel when the count is not a square.
+  void samplePosition(uint32_t x, uint32_t y, uint32_t s, uint64_t& rng, double& sx, double& sy) const {
+    sx = x + 0.5, sy = y + 0.5;
+    if (options.samples <= 1) return;
+    const uint32_t strata = uint32_t(std::lround(std::sqrt(double(options.samples))));
+    if (strata * strata == options.samples) {
+      sx = x + ((s % strata) + uniform(rng)) / strata;
+      sy = y + ((s / strata) + uniform(rng)) / strata;
+    } else {
+      sx = x + uniform(rng);
+      sy = y + uniform(rng);
+    }
+  }
+
+  // The samples of one packet (primary rays `rays`, one per pixel of a block) in the image's channels.
+  void shadeSamples(std::span<const Ray> rays, float (*value)[3], TraceStats& st) const {
+    const uint32_t count = uint32_t(rays.size());
+    if (nearestHitMode()) {
+      Hit hits[kMaxPacketRays];
+      tracePacket(accel, rays, {hits, count}, &st);
+      if (options.mode == RenderMode::Shade)
+        shadePacket(rays, {hits, count}, value, st);
+      else
+        for (uint32_t p = 0; p < count; ++p) fromHit(rays[p], hits[p], value[p]);
+    } else {
+      for (uint32_t p = 0; p < count; ++p) walkSample(rays[p], value[p], st);
+    }
+  }
+
+  // Pixels [x0, x1) x [y0, y1) (at most kBlock a side): every sample, the average into `image`, and each sample
+  // into `store` when a reconstruction filter will make the image instead.
+  void renderBlock(uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1, Image& image, SampleStore& store,
+                   TraceStats& st) const {
+    uint32_t px[kMaxPacketRays], py[kMaxPacketRays], count = 0;
+    uint64_t rng[kMaxPacketRays];
+    for (uint32_t y = y0; y < y1; ++y)
+      for (uint32_t x = x0; x < x1; ++x) {
+        px[count] = x, py[count] = y;
+        rng[count++] = options.seed ^ ((uint64_t(y) << 32) | x) * 0x9e3779b97f4a7c15ull;
+      }
+    float sum[kMaxPacketRays][3] = {};
+    Ray rays[kMaxPacketRays];
+    for (uint32_t s = 0; s < options.samples; ++s) {
+      double jx[kMaxPacketRays], jy[kMaxPacketRays];
+      for (uint32_t p = 0; p < count; ++p) {
+        double sx, sy;
+        samplePosition(px[p], py[p], s, rng[p], sx, sy);
+        rays[p] = rayFromFrame(options.camera, frame, image.width, image.height, sx, sy);
+        jx[p] = sx - px[p], jy[p] = sy - py[p];
+      }
+      float value[kMaxPacketRays][3];
+      shadeSamples({rays, count}, value, st);
+      for (uint32_t p = 0; p < count; ++p)
+        for (uint32_t c = 0; c < image.channels; ++c) sum[p][c] += value[p][c];
+      if (store.active())
+        for (uint32_t p = 0; p < count; ++p) store.put(px[p], py[p], s, jx[p], jy[p], value[p]);
+    }
+    for (uint32_t p = 0; p < count; ++p) {
+      float* out = image.at(px[p], py[p]);
+      for (uint32_t c = 0; c < image.channels; ++c) out[c] = sum[p][c] / float(options.samples);
+    }
+  }
+
   // One sample of the voxels or count mode.
   void walkSample(const Ray& ray, float* out, TraceStats& st) const {
     if (options.mode == RenderMode::Voxels) {
@@ -209,6 +277,33 @@ struct Renderer {
     }
   }
 };
+
+// The count mode's cells per pixel as a heat map (the largest count in `maxCount`).
+Image countToHeat(const Image& counts, float& maxCount) {
+  maxCount = 0;
+  for (float v : counts.pixels) maxCount = std::max(maxCount, v);
+  Image heat;
+  heat.width = counts.width;
+  heat.height = counts.height;
+  heat.channels = 3;
+  heat.pixels.resize(uint64_t(counts.width) * counts.height * 3);
+  for (uint64_t i = 0; i < uint64_t(counts.width) * counts.height; ++i) {
+    const Vec3 c = heatColor(counts.pixels[i], maxCount);
+    heat.pixels[3 * i] = float(c.x), heat.pixels[3 * i + 1] = float(c.y), heat.pixels[3 * i + 2] = float(c.z);
+  }
+  return heat;
+}
+
+// The smallest and largest depth of the pixels that hit something (depth > 0); both stay as they are when none did.
+void depthRange(const Image& depth, double& lo, double& hi) {
+  bool any = false;
+  for (float v : depth.pixels) {
+    if (v <= 0) continue;
+    lo = any ? std::min(lo, double(v)) : v;
+    hi = any ? std::max(hi, double(v)) : v;
+    any = true;
+  }
+}
 
 }  // namespace
 
@@ -241,8 +336,6 @@ Image traceImage(const Scene& scene, const Accel& accel, const RenderOptions& op
   SampleStore store;
   if (options.filter != FilterKind::None)
     store = makeSampleStore(image.width, image.height, options.samples, image.channels);
-  const uint32_t strata = uint32_t(std::lround(std::sqrt(double(options.samples))));
-  const bool stratified = strata * strata == options.samples;
   tbb::combinable<TraceStats> perThread;
   std::atomic<uint64_t> rowsDone{0};
   const auto start = std::chrono::steady_clock::now();
@@ -250,60 +343,13 @@ Image traceImage(const Scene& scene, const Accel& accel, const RenderOptions& op
   tbb::parallel_for(tbb::blocked_range2d<uint32_t>(0, image.height, kTile, 0, image.width, kTile),
                     [&](const tbb::blocked_range2d<uint32_t>& tile) {
                       TraceStats& st = perThread.local();
-                      // Blocks of 8x8 pixels: each sample index of a block is one packet of primary rays.
-                      constexpr uint32_t kBlock = 8;
-                      static_assert(kBlock * kBlock <= kMaxPacketRays);
-                      for (uint32_t by = tile.rows().begin(); by < tile.rows().end(); by += kBlock) {
-                        for (uint32_t bx = tile.cols().begin(); bx < tile.cols().end(); bx += kBlock) {
-                          uint32_t px[kMaxPacketRays], py[kMaxPacketRays], count = 0;
-                          uint64_t rng[kMaxPacketRays];
-                          for (uint32_t y = by; y < std::min(by + kBlock, tile.rows().end()); ++y)
-                            for (uint32_t x = bx; x < std::min(bx + kBlock, tile.cols().end()); ++x) {
-                              px[count] = x, py[count] = y;
-                              rng[count++] = options.seed ^ ((uint64_t(y) << 32) | x) * 0x9e3779b97f4a7c15ull;
-                            }
-                          float sum[kMaxPacketRays][3] = {};
-                          double jx[kMaxPacketRays], jy[kMaxPacketRays];
-                          Ray rays[kMaxPacketRays];
-                          Hit hits[kMaxPacketRays];
-                          for (uint32_t s = 0; s < options.samples; ++s) {
-                            for (uint32_t p = 0; p < count; ++p) {
-                              double sx = px[p] + 0.5, sy = py[p] + 0.5;
-                              if (options.samples > 1) {
-                                if (stratified) {
-                                  sx = px[p] + ((s % strata) + uniform(rng[p])) / strata;
-                                  sy = py[p] + ((s / strata) + uniform(rng[p])) / strata;
-                                } else {
-                                  sx = px[p] + uniform(rng[p]);
-                                  sy = py[p] + uniform(rng[p]);
-                                }
-                              }
-                              rays[p] = rayFromFrame(options.camera, r.frame, image.width, image.height, sx, sy);
-                              jx[p] = sx - px[p], jy[p] = sy - py[p];
-                            }
-                            float value[kMaxPacketRays][3];
-                            if (r.nearestHitMode()) {
-                              tracePacket(accel, {rays, count}, {hits, count}, &st);
-                              if (options.mode == RenderMode::Shade)
-                                r.shadePacket({rays, count}, {hits, count}, value, st);
-                              else
-                                for (uint32_t p = 0; p < count; ++p) r.fromHit(rays[p], hits[p], value[p]);
-                            } else {
-                              for (uint32_t p = 0; p < count; ++p) r.walkSample(rays[p], value[p], st);
-                            }
-                            for (uint32_t p = 0; p < count; ++p)
-                              for (uint32_t c = 0; c < image.channels; ++c) sum[p][c] += value[p][c];
-                            if (store.active())
-                              for (uint32_t p = 0; p < count; ++p) store.put(px[p], py[p], s, jx[p], jy[p], value[p]);
-                          }
-                          for (uint32_t p = 0; p < count; ++p) {
-                            float* out = image.at(px[p], py[p]);
-                            for (uint32_t c = 0; c < image.channels; ++c) out[c] = sum[p][c] / float(options.samples);
-                          }
-                        }
-                      }
-                      if (options.progress && tile.cols().end() == image.width) {
-                        const uint64_t done = rowsDone.fetch_add(tile.rows().size()) + tile.rows().size();
+                      const auto rows = tile.rows(), cols = tile.cols();
+                      for (uint32_t by = rows.begin(); by < rows.end(); by += Renderer::kBlock)
+                        for (uint32_t bx = cols.begin(); bx < cols.end(); bx += Renderer::kBlock)
+                          r.renderBlock(bx, std::min(bx + Renderer::kBlock, cols.end()), by,
+                                        std::min(by + Renderer::kBlock, rows.end()), image, store, st);
+                      if (options.progress && cols.end() == image.width) {
+                        const uint64_t done = rowsDone.fetch_add(rows.size()) + rows.size();
                         options.progress(double(done) / image.height);
                       }
                     });
@@ -315,26 +361,10 @@ Image traceImage(const Scene& scene, const Accel& accel, const RenderOptions& op
   rs.traceSeconds = seconds;
   if (options.mode == RenderMode::Count) {
     float maxCount = 0;
-    for (float v : image.pixels) maxCount = std::max(maxCount, v);
+    image = countToHeat(image, maxCount);
     rs.countMax = maxCount;
-    Image heat;
-    heat.width = image.width;
-    heat.height = image.height;
-    heat.channels = 3;
-    heat.pixels.resize(uint64_t(image.width) * image.height * 3);
-    for (uint64_t i = 0; i < uint64_t(image.width) * image.height; ++i) {
-      const Vec3 c = heatColor(image.pixels[i], maxCount);
-      heat.pixels[3 * i] = float(c.x), heat.pixels[3 * i + 1] = float(c.y), heat.pixels[3 * i + 2] = float(c.z);
-    }
-    image = std::move(heat);
   } else if (options.mode == RenderMode::Depth) {
-    bool any = false;
-    for (float v : image.pixels) {
-      if (v <= 0) continue;
-      rs.depthMin = any ? std::min(rs.depthMin, double(v)) : v;
-      rs.depthMax = any ? std::max(rs.depthMax, double(v)) : v;
-      any = true;
-    }
+    depthRange(image, rs.depthMin, rs.depthMax);
   }
   if (stats) *stats = rs;
   return image;

@@ -67,7 +67,12 @@ inline void exerciseDecodedGrid(const GridFile& file) {
   try {
     const Accel accel = buildAccel(file.scene, file.grid, AccelKind::Grid);
     RenderOptions options;
-    options.width = options.height = 6;
+    // A walk is bounded by the sum of the grid's dims, and a valid but degenerate grid reaches that bound on every
+    // ray (674627x2x1 cells, 1.8e88 deep: every cell within the walk's tolerance of its neighbours; 0.25 s for 36
+    // rays in release, a hundred times that under coverage and ASan, tests/data/fuzz/grid/timeout-27cc5893-*). Such
+    // long walks get one ray per image, so that the fuzzer's time goes to new inputs.
+    const auto& d = file.grid.dims;
+    options.width = options.height = uint64_t(d[0]) + d[1] + d[2] > 65536 ? 1 : 6;
     const auto bounds = sceneBounds(file.scene);
     options.camera = file.scene.camera ? *file.scene.camera : defaultCamera(bounds ? *bounds : file.grid.bounds);
     for (RenderMode mode : {RenderMode::Shade, RenderMode::Voxels, RenderMode::Depth}) {

@@ -368,6 +368,52 @@ TEST(WalkRobustness, OneCellGrid) {
   EXPECT_GT(expectSameHits(scene, grid, randomRays(rng, *sceneBounds(scene), 1000), "1x1x1"), 60);
 }
 
+TEST(WalkRobustness, LongThinGridJumpsItsEmptyRunWhole) {
+  // A 2^20 x 2 x 1 grid with a triangle near each end (a 674627x2x1 grid from the fuzzer took a walk one loop turn
+  // per empty cell): the empty run between them is one aligned box of 2^19 cells and more (Accel::emptyShift has
+  // no cap on the box size), crossed by bisection (GridWalker::advanceBySearch) rather than cell by cell. Hits,
+  // occlusion and the first occupied cell must equal the brute force and the walk over 4-cell blocks.
+  Scene scene;
+  scene.materials.push_back({});
+  for (double x : {0.0003, 0.9996})
+    scene.triangles.push_back(Triangle{{Vec3{x, -0.1, -0.1}, Vec3{x + 1e-4, 1.1, -0.1}, Vec3{x, 0.5, 1.1}}});
+  const Grid grid = voxelize(scene, {1u << 20, 2, 1}, OverlapMethod::Exact, Box{{0, 0, 0}, {1, 1, 1}});
+  const Accel g = buildAccel(scene, grid, AccelKind::Grid);
+  const Accel none = buildAccel(scene, grid, AccelKind::None);
+  ASSERT_NE(g.blockShift, 0u);
+  const uint32_t middle = (1u << 19) >> g.blockShift;
+  EXPECT_GE(g.emptyShift[middle], 18u) << "the empty run is not one big box";
+  Accel blocksOnly = buildAccel(scene, grid, AccelKind::Grid);
+  blocksOnly.emptyShift.clear();  // jumps of one block at a time, by the loop
+
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  const auto start = std::chrono::steady_clock::now();
+  int hits = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const bool inside = i % 3 == 0;
+    const Vec3 o = inside ? Vec3{0.01 + 0.98 * u(rng), u(rng), u(rng)} : Vec3{-0.5 - u(rng), u(rng), u(rng)};
+    const Vec3 target{i % 2 ? 1.2 : -0.2, u(rng), u(rng)};
+    const Ray ray{o, target - o};
+    const Hit a = traceRay(g, ray), b = traceRay(none, ray);
+    ASSERT_EQ(a.prim, b.prim) << i;
+    ASSERT_EQ(std::memcmp(&a.t, &b.t, sizeof(double)), 0) << i;
+    ASSERT_EQ(occluded(g, ray), occluded(none, ray)) << i;
+    hits += a.valid();
+    if (i % 20 != 0) continue;  // the walk over blocks crosses the run cell by cell: a sample of the rays
+    const CellHit c = firstOccupiedCell(g, ray), d = firstOccupiedCell(blocksOnly, ray);
+    ASSERT_EQ(c.hit, d.hit) << i;
+    if (c.hit) {
+      EXPECT_EQ(c.idx, d.idx) << i;
+      EXPECT_EQ(std::memcmp(&c.t, &d.t, sizeof(double)), 0) << i;
+      EXPECT_EQ(c.entryAxis, d.entryAxis) << i;
+    }
+  }
+  EXPECT_GT(hits, 1000);
+  // A guard against walking the run cell by cell on every ray again, not a speed measurement.
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 20.0);
+}
+
 TEST(WalkRobustness, Grid2048CubedDiagonalAndAxisRays) {
   // Few small triangles in a 2048^3 grid: the walk must stay bounded by the cells on the path and be quick.
   const uint32_t n = 2048;
@@ -642,7 +688,7 @@ TEST(WalkRobustness, ExactCoverageThroughRoundedCorners) {
   for (int sparsity : {5, 40}) {
     for (uint32_t& slot : sparse.blockSlot) slot = rng() % sparsity == 0 ? 0 : kEmptyCell;
     buildEmptyShift(sparse);
-    int levels[4] = {0, 0, 0, 0};
+    int levels[40] = {};
     for (uint8_t s : sparse.emptyShift) {
       if (s != 0) ++levels[s - sparse.blockShift];
     }

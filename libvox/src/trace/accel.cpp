@@ -49,9 +49,9 @@ constexpr uint64_t kMaxBlocks = uint64_t(1) << 25;
 
 void buildTables(Accel& accel, const Grid& grid) {
   const auto& dims = grid.dims;
-  // Smallest block size (4, 8 or 16 cells a side) whose block array stays small.
+  // Smallest block size (4 to 64 cells a side) whose block array stays small.
   uint32_t shift = 0;
-  for (uint32_t s = 2; s <= 4 && shift == 0; ++s) {
+  for (uint32_t s = 2; s <= 6 && shift == 0; ++s) {
     uint64_t blocks = 1;
     for (int a = 0; a < 3; ++a) blocks *= (uint64_t(dims[a]) + (1u << s) - 1) >> s;
     if (blocks <= kMaxBlocks) shift = s;
@@ -104,29 +104,43 @@ void buildTables(Accel& accel, const Grid& grid) {
 void buildEmptyShift(Accel& accel) {
   accel.emptyShift.clear();
   if (accel.blockShift == 0) return;
-  const auto& bd = accel.blockDims;
-  accel.emptyShift.assign(accel.blockSlot.size(), 0);
-  for (size_t b = 0; b < accel.blockSlot.size(); ++b)
-    if (accel.blockSlot[b] == kEmptyCell) accel.emptyShift[b] = uint8_t(accel.blockShift);
-  // Level L: boxes of 2^L blocks a side; empty[L] from the 2x2x2 boxes of level L - 1 (those past the grid empty).
-  std::array<uint32_t, 3> d = bd;
-  std::vector<uint8_t> empty(accel.blockSlot.size());
-  for (size_t b = 0; b < empty.size(); ++b) empty[b] = accel.blockSlot[b] == kEmptyCell;
-  for (uint32_t level = 1; level <= kMaxSkipLevels; ++level) {
-    const std::array<uint32_t, 3> h{(d[0] + 1) / 2, (d[1] + 1) / 2, (d[2] + 1) / 2};
+  // A pyramid of emptiness: level 0 the blocks (1 = empty), level L the aligned boxes of 2^L blocks a side, each
+  // empty when its eight children are (those past the grid count as empty), up to the one box holding the grid. Every
+  // level is an eighth of the one below, so the pyramid costs a seventh of the blocks more.
+  std::vector<std::array<uint32_t, 3>> dims{accel.blockDims};
+  std::vector<std::vector<uint8_t>> level(1);
+  level[0].resize(accel.blockSlot.size());
+  for (size_t b = 0; b < level[0].size(); ++b) level[0][b] = accel.blockSlot[b] == kEmptyCell;
+  while (std::max({dims.back()[0], dims.back()[1], dims.back()[2]}) > 1) {
+    const std::array<uint32_t, 3> d = dims.back(), h{(d[0] + 1) / 2, (d[1] + 1) / 2, (d[2] + 1) / 2};
     std::vector<uint8_t> up(size_t(h[0]) * h[1] * h[2], 1);
+    const std::vector<uint8_t>& below = level.back();
     for (uint32_t z = 0; z < d[2]; ++z)
       for (uint32_t y = 0; y < d[1]; ++y)
         for (uint32_t x = 0; x < d[0]; ++x)
-          if (!empty[x + d[0] * (y + uint64_t(d[1]) * z)]) up[x / 2 + h[0] * (y / 2 + uint64_t(h[1]) * (z / 2))] = 0;
-    for (uint32_t z = 0; z < bd[2]; ++z)
-      for (uint32_t y = 0; y < bd[1]; ++y)
-        for (uint32_t x = 0; x < bd[0]; ++x)
-          if (up[(x >> level) + h[0] * ((y >> level) + uint64_t(h[1]) * (z >> level))])
-            accel.emptyShift[x + bd[0] * (y + uint64_t(bd[1]) * z)] = uint8_t(accel.blockShift + level);
-    empty = std::move(up);
-    d = h;
+          if (!below[x + d[0] * (y + uint64_t(d[1]) * z)]) up[x / 2 + h[0] * (y / 2 + uint64_t(h[1]) * (z / 2))] = 0;
+    level.push_back(std::move(up));
+    dims.push_back(h);
   }
+  // Top down, each entry becomes 1 + the level of the largest empty box holding it (0: not empty): its parent's
+  // value when the parent is empty, else its own level.
+  const size_t top = level.size() - 1;
+  for (uint8_t& v : level[top]) v = v ? uint8_t(top + 1) : 0;
+  for (size_t l = top; l-- > 0;) {
+    const std::array<uint32_t, 3> d = dims[l], h = dims[l + 1];
+    const std::vector<uint8_t>& parent = level[l + 1];
+    std::vector<uint8_t>& v = level[l];
+    for (uint32_t z = 0; z < d[2]; ++z)
+      for (uint32_t y = 0; y < d[1]; ++y)
+        for (uint32_t x = 0; x < d[0]; ++x) {
+          uint8_t& e = v[x + d[0] * (y + uint64_t(d[1]) * z)];
+          const uint8_t p = parent[x / 2 + h[0] * (y / 2 + uint64_t(h[1]) * (z / 2))];
+          if (e) e = p != 0 ? p : uint8_t(l + 1);
+        }
+  }
+  accel.emptyShift.assign(level[0].size(), 0);
+  for (size_t b = 0; b < level[0].size(); ++b)
+    if (level[0][b]) accel.emptyShift[b] = uint8_t(accel.blockShift + level[0][b] - 1);
 }
 
 Accel buildAccel(const Scene& scene, const Grid& grid, AccelKind kind) {

@@ -82,9 +82,9 @@ struct Accel {
   std::array<uint32_t, 3> blockDims{0, 0, 0};
   std::vector<uint32_t> blockSlot;
   std::vector<uint32_t> cellSlots;
-  // Per block (blockSlot order): 0 when the block holds a cell, else the largest s in [blockShift, blockShift +
-  // kMaxSkipLevels] such that the aligned box of 2^s cells a side holding the block is empty (cells past the grid
-  // count as empty), so that a walk skips a run of empty space in one jump per box rather than per block
+  // Per block (blockSlot order): 0 when the block holds a cell, else the largest s >= blockShift such that the
+  // aligned box of 2^s cells a side holding the block is empty (cells past the grid count as empty; s stops at the
+  // box holding the whole grid), so that a walk skips a run of empty space in one jump per box rather than per block
   // (GridWalker::fastForward; issue 12). Empty when there are no block tables.
   std::vector<uint8_t> emptyShift;
   // The triangles of the cells, copied in cell order: cellTriangles[r] == triangles[grid->primIds[r]] when that id is
@@ -127,7 +127,6 @@ struct Accel {
   std::span<const uint32_t> cellPrims(uint32_t occupiedIndex) const { return grid->cellPrims(occupiedIndex); }
 };
 
-inline constexpr uint32_t kMaxSkipLevels = 3;
 // Fills accel.emptyShift from accel.blockSlot (nothing without block tables).
 void buildEmptyShift(Accel& accel);
 

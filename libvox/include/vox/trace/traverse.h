@@ -231,6 +231,9 @@ class GridWalker {
     return skip > minSkip_ ? skip : 0;
   }
   void fastForward(uint32_t shift);
+  // Boxes whose far face lies more cells away on an axis than this are crossed by advanceBySearch, not cell by cell.
+  static constexpr int64_t kMaxLoopCells = 32;
+  void advanceBySearch(int a, int64_t far, double T);
 
   std::unique_ptr<CellBoundaries> owned_;  // the tables, when the walker built them itself
   const double* bnd_[3] = {nullptr, nullptr, nullptr};

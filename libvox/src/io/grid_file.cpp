@@ -237,7 +237,10 @@ std::string encodeGridFile(const Scene& scene, const Grid& grid) {
   return bytes;
 }
 
-GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
+namespace {
+
+// The 32-byte header: magic, version (returned), flags, payload size and checksum, checked against the bytes.
+uint32_t checkHeader(const std::string& bytes, const std::string& name) {
   if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0)
     fail<InputError>(name, ": not a libvox grid file (bad magic number)");
   ByteReader header(bytes, 8, name);
@@ -257,24 +260,23 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
   }
   if (wordChecksum(bytes.data() + kHeaderSize, payloadSize) != expected)
     fail<InputError>(name, ": checksum mismatch: the file is corrupt");
+  return version;
+}
 
-  ByteReader r(bytes, kHeaderSize, name);
-  GridFile out;
-  Scene& scene = out.scene;
+// Materials and primitives of the payload, each primitive's material index checked.
+void getPrimitives(ByteReader& r, Scene& scene) {
   const uint64_t nMaterials = r.getCount(4 + 14 * 8, "material");
   for (uint64_t i = 0; i < nMaterials; ++i) scene.materials.push_back(getMaterial(r));
   auto material = [&](uint32_t m) {
     if (m >= nMaterials) r.corrupt("material index " + std::to_string(m) + " out of range");
     return m;
   };
-  const uint64_t nTri = r.getCount(9 * 8 + 4, "triangle");
-  scene.triangles.resize(nTri);
+  scene.triangles.resize(r.getCount(9 * 8 + 4, "triangle"));
   for (auto& t : scene.triangles) {
     for (auto& v : t.v) v = r.getVec("vertex");
     t.material = material(r.get<uint32_t>());
   }
-  const uint64_t nSph = r.getCount(20 * 8 + 4, "sphere");
-  scene.spheres.resize(nSph);
+  scene.spheres.resize(r.getCount(20 * 8 + 4, "sphere"));
   for (auto& s : scene.spheres) {
     s.center = r.getVec("sphere centre");
     s.radius = r.getFinite("sphere radius");
@@ -283,13 +285,16 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
       for (double& x : row) x = r.getFinite("sphere transform");
     s.material = material(r.get<uint32_t>());
   }
-  const uint64_t nPlane = r.getCount(4 * 8 + 4, "plane");
-  scene.planes.resize(nPlane);
+  scene.planes.resize(r.getCount(4 * 8 + 4, "plane"));
   for (auto& p : scene.planes) {
     p.normal = r.getVec("plane normal");
     p.offset = r.getFinite("plane offset");
     p.material = material(r.get<uint32_t>());
   }
+}
+
+// Camera, lights, background and ambient light.
+void getView(ByteReader& r, Scene& scene) {
   const uint8_t hasCamera = r.get<uint8_t>();
   if (hasCamera > 1) r.corrupt("invalid camera flag");
   if (hasCamera) {
@@ -304,8 +309,7 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
     c.orthoHeight = r.getFinite("camera size");
     scene.camera = c;
   }
-  const uint64_t nLights = r.getCount(1 + 12 * 8, "light");
-  scene.lights.resize(nLights);
+  scene.lights.resize(r.getCount(1 + 12 * 8, "light"));
   for (auto& l : scene.lights) {
     const uint8_t kind = r.get<uint8_t>();
     if (kind > 1) r.corrupt("unknown light kind " + std::to_string(kind));
@@ -317,8 +321,10 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
   }
   scene.background = r.getVec("background");
   scene.ambient = r.getVec("ambient");
+}
 
-  Grid& grid = out.grid;
+// Bounds, dims (checked against the cell boundary formula) and overlap method.
+void getGridShape(ByteReader& r, Grid& grid) {
   grid.bounds.lo = r.getVec("bounds");
   grid.bounds.hi = r.getVec("bounds");
   for (int a = 0; a < 3; ++a)
@@ -333,26 +339,13 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
   const uint8_t method = r.get<uint8_t>();
   if (method > uint8_t(OverlapMethod::Exact)) r.corrupt("unknown overlap method " + std::to_string(method));
   grid.method = OverlapMethod(method);
+}
 
-  const size_t cellsAt = r.position();
-  grid.cellKeys = r.getArray<uint64_t>("cell");
-  grid.cellStart = r.getArray<uint64_t>("cell start");
-  grid.primIds = r.getArray<uint32_t>("reference");
-  grid.outsidePrims = r.getArray<uint32_t>("outside primitive");
-  const uint64_t cells = grid.cellCount();
-  if (version == 1) {
-    grid.solidRuns = getSolidKeysAsRuns(r, cells);
-    if (!r.atEnd()) r.corrupt("unexpected bytes after the solid cells");
-  } else {
-    const size_t runsAt = r.position();
-    grid.solidRuns = r.getArray<CellRun>("solid run");
-    checkSolidRuns(grid.solidRuns, cells, name + ": solid runs at byte " + std::to_string(runsAt));
-    getSections(r, scene, grid);
-  }
-
-  // Structural checks: sorted unique keys inside the grid, offsets that partition the references, ids in range.
+// Structural checks of the cell table read at byte `cellsAt`: sorted unique keys inside the grid, offsets that
+// partition the references, ids below `bounded` (the triangles and spheres).
+void checkCellTable(const Grid& grid, uint64_t bounded, const std::string& name, size_t cellsAt) {
   auto bad = [&](const std::string& what) { fail<InputError>(name, ": cell table at byte ", cellsAt, ": ", what); };
-  const uint64_t bounded = nTri + nSph;
+  const uint64_t cells = grid.cellCount();
   for (size_t c = 0; c < grid.cellKeys.size(); ++c)
     if (grid.cellKeys[c] >= cells || (c > 0 && grid.cellKeys[c] <= grid.cellKeys[c - 1]))
       bad("cell keys not sorted or outside the grid");
@@ -371,6 +364,36 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
   }
   for (uint32_t id : grid.outsidePrims)
     if (id >= bounded) bad("outside primitive id out of range");
+}
+
+}  // namespace
+
+GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
+  const uint32_t version = checkHeader(bytes, name);
+  ByteReader r(bytes, kHeaderSize, name);
+  GridFile out;
+  Scene& scene = out.scene;
+  getPrimitives(r, scene);
+  getView(r, scene);
+  Grid& grid = out.grid;
+  getGridShape(r, grid);
+
+  const size_t cellsAt = r.position();
+  grid.cellKeys = r.getArray<uint64_t>("cell");
+  grid.cellStart = r.getArray<uint64_t>("cell start");
+  grid.primIds = r.getArray<uint32_t>("reference");
+  grid.outsidePrims = r.getArray<uint32_t>("outside primitive");
+  const uint64_t cells = grid.cellCount();
+  if (version == 1) {
+    grid.solidRuns = getSolidKeysAsRuns(r, cells);
+    if (!r.atEnd()) r.corrupt("unexpected bytes after the solid cells");
+  } else {
+    const size_t runsAt = r.position();
+    grid.solidRuns = r.getArray<CellRun>("solid run");
+    checkSolidRuns(grid.solidRuns, cells, name + ": solid runs at byte " + std::to_string(runsAt));
+    getSections(r, scene, grid);
+  }
+  checkCellTable(grid, scene.triangles.size() + scene.spheres.size(), name, cellsAt);
   // The same checks as at import (singular ellipsoid transforms, cameras that cannot form an image, materials),
   // so a grid file that passes here traces and exports.
   validateScene(scene, name);

@@ -211,8 +211,8 @@ void GridWalker::fastForward(uint32_t shift) {
 // before T) in O(log n) for a big box: the crossings met along an axis never decrease (the boundaries are sorted and
 // (b - o) * inv rounds monotonically), so the loop stops at the first k whose crossing is not below T, found by
 // bisection. The state after it is the loop's bit for bit: k more steps, tCur raised to the last crossing passed
-// (and the entry axis set) when that exceeds it, and the next crossing. A long thin grid's empty run (a 674627x2x1
-// grid from the fuzzer) cost its walks one loop turn per cell.
+// (and the entry axis set) when that exceeds it, and the next crossing. The loop cost one turn per cell of a big box
+// (an 8192^3 grid's empty space, a long thin grid's empty run).
 void GridWalker::advanceBySearch(int a, int64_t far, double T) {
   const int64_t i0 = idx_[a], s = step_[a];
   // The boundary crossed by the k-th step from i0 (k = 0: the next one) and the number of steps to the box's end.

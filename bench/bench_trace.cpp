@@ -401,6 +401,14 @@ void voxPackets(const vox::Accel& accel, const RaySet& set, std::vector<vox::Hit
   });
 }
 
+// How many of two methods' results differ in primitive or in the bits of t.
+uint64_t differingHits(const std::vector<vox::Hit>& a, const std::vector<vox::Hit>& b) {
+  uint64_t n = 0;
+  for (size_t i = 0; i < a.size(); ++i)
+    n += a[i].prim != b[i].prim || std::memcmp(&a[i].t, &b[i].t, sizeof(double)) != 0;
+  return n;
+}
+
 // How our results compare with Embree's: the same triangle (or both miss, or the same occluded flag), a different
 // triangle at a t within float tolerance (coincident or adjacent surfaces, an edge hit), or a mismatch.
 struct Agreement {
@@ -491,13 +499,7 @@ void benchIncoherent(const std::string& path, unsigned threads, uint32_t size, i
     std::vector<vox::Hit> packetHits(set.rays.size());
     methods.push_back({"ours packets", [&] { voxPackets(accel, set, packetHits); }});
     timeInTurns(methods, reps);
-    uint64_t packetDiff = 0;
-    for (size_t i = 0; i < ours.size(); ++i)
-      packetDiff +=
-          ours[i].prim != packetHits[i].prim || std::memcmp(&ours[i].t, &packetHits[i].t, sizeof(double)) != 0;
-    uint64_t byIdDiff = 0;
-    for (size_t i = 0; i < ours.size(); ++i)
-      byIdDiff += ours[i].prim != byIdHits[i].prim || std::memcmp(&ours[i].t, &byIdHits[i].t, sizeof(double)) != 0;
+    const uint64_t packetDiff = differingHits(ours, packetHits), byIdDiff = differingHits(ours, byIdHits);
     const Agreement a = compareWithEmbree(set, ours, e, diag);
     uint64_t checked = 0;
     const uint64_t bruteDiff =

@@ -112,6 +112,7 @@ struct Renderer {
   Frame frame;
   Shader shader;
   uint32_t maxCellPrims = 1;
+  uint32_t strata = 1;  // round(sqrt(samples)): samples are stratified when its square is the sample count
 
   // The shade mode for a packet of primary rays and their hits: the shadow rays of each light are traced as packets
   // too (they start near each other and end at one light, or run parallel); reflected and refracted rays, and the
@@ -205,7 +206,6 @@ struct Renderer {
   void samplePosition(uint32_t x, uint32_t y, uint32_t s, uint64_t& rng, double& sx, double& sy) const {
     sx = x + 0.5, sy = y + 0.5;
     if (options.samples <= 1) return;
-    const uint32_t strata = uint32_t(std::lround(std::sqrt(double(options.samples))));
     if (strata * strata == options.samples) {
       sx = x + ((s % strata) + uniform(rng)) / strata;
       sy = y + ((s / strata) + uniform(rng)) / strata;
@@ -325,6 +325,7 @@ Image traceImage(const Scene& scene, const Accel& accel, const RenderOptions& op
   r.shader.sceneSize = std::max(length(b.hi - b.lo), 1e-300);
   for (size_t c = 0; c < accel.grid->occupiedCount(); ++c)
     r.maxCellPrims = std::max<uint32_t>(r.maxCellPrims, uint32_t(accel.grid->cellPrims(c).size()));
+  r.strata = uint32_t(std::lround(std::sqrt(double(options.samples))));
 
   Image image;
   image.width = options.width;
@@ -372,14 +373,8 @@ Image traceImage(const Scene& scene, const Accel& accel, const RenderOptions& op
 
 Image depthToGrey(const Image& depth) {
   Image grey = depth;
-  float lo = 0, hi = 0;
-  bool any = false;
-  for (float v : depth.pixels) {
-    if (v <= 0) continue;
-    lo = any ? std::min(lo, v) : v;
-    hi = any ? std::max(hi, v) : v;
-    any = true;
-  }
+  double lo = 0, hi = 0;  // float values, exactly
+  depthRange(depth, lo, hi);
   for (float& v : grey.pixels) {
     if (v <= 0) continue;
     // Linear in inverse depth, so that a floor running to the horizon does not wash out everything near.

@@ -35,7 +35,7 @@ seed() {  # seed TARGET FILE...
   return 0
 }
 shopt -s nullglob
-seed_dir=${VOX_SEED_DIR:-$root/../shared/seed-scenes}
+seed_dir=$("$root/scripts/seed-dir.sh")
 course_seeds=("$root"/scenes/*.txt "$seed_dir"/6837/scenes/*.txt)
 seed course "${course_seeds[@]}"
 seed obj "$root"/scenes/*.obj "$root"/tests/data/*.obj "$seed_dir"/6837/scenes/*.obj

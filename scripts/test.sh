@@ -4,6 +4,8 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 "$root/scripts/install-deps.sh" --clients
 build=${1:-$root/build}
+VOX_SEED_DIR=$("$root/scripts/seed-dir.sh")
+export VOX_SEED_DIR
 shift || true
 "$root/scripts/build.sh" "$build" -DVOX_TESTS=ON "$@"
 echo "test.sh: $build built at $SECONDS s" >&2

@@ -12,7 +12,10 @@
 // rtcIntersect1 / rtcOccluded1 and vox::traceRay / vox::occluded. Outside the timed runs, every ray's result is
 // compared with Embree's (same triangle, or t within float tolerance; same occluded flag) and a sample with the
 // brute force (--accel none), bit for bit; and our walk without the float filter (every triangle tested in double,
-// the `double only` column: its time over ours) is timed in the same turns and checked equal.
+// the `double only` column: its time over ours) is timed in the same turns and checked equal. The yardstick of the
+// goal: the textbook walk (textbook_walk.h: no tolerances, same cells, filter and tests; `textbook/embree`, with how
+// many of its results differ from ours) and that walk alone over the cells up to each ray's nearest hit, no test
+// (`walk alone`: Embree's time over its time).
 // The methods take turns, `reps` rounds, so that a burst of load on a shared machine hits them alike; each keeps its
 // best and median time.
 #include <embree3/rtcore.h>
@@ -40,6 +43,7 @@
 #include "vox/trace/trace_packet.h"
 #include "vox/trace/traverse.h"
 #include "vox/voxelize/voxelize.h"
+#include "textbook_walk.h"
 
 namespace {
 
@@ -381,6 +385,37 @@ void voxTrace(const vox::Accel& accel, const RaySet& set, std::vector<vox::Hit>&
   });
 }
 
+// The textbook walk (textbook_walk.h), compiled like our walks (one copy per instruction set, picked at load time).
+#define VOX_BENCH_COPIES [[gnu::target_clones("arch=x86-64-v4", "avx2", "default"), gnu::flatten]]
+VOX_BENCH_COPIES vox::Hit textbookNearest(const vox::Accel& accel, const vox::Ray& ray) {
+  return textbook::trace<false>(accel, ray);
+}
+VOX_BENCH_COPIES bool textbookAny(const vox::Accel& accel, const vox::Ray& ray) {
+  return textbook::trace<true>(accel, ray).valid();
+}
+VOX_BENCH_COPIES uint64_t textbookWalkOnly(const vox::Accel& accel, const vox::Ray& ray, double tStop) {
+  return textbook::walkOnly(accel, ray, tStop);
+}
+#undef VOX_BENCH_COPIES
+
+void textbookTrace(const vox::Accel& accel, const RaySet& set, std::vector<vox::Hit>& out) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, set.rays.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i)
+      out[i] = set.occlusion ? (textbookAny(accel, set.rays[i]) ? vox::Hit{0, 0} : vox::Hit{})
+                             : textbookNearest(accel, set.rays[i]);
+  });
+}
+
+// The textbook walk's cells up to each ray's nearest hit (`stopT`), looked up and not tested.
+void textbookWalk(const vox::Accel& accel, const RaySet& set, const std::vector<double>& stopT,
+                  std::atomic<uint64_t>& sink) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, set.rays.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
+    uint64_t sum = 0;
+    for (size_t i = r.begin(); i < r.end(); ++i) sum += textbookWalkOnly(accel, set.rays[i], stopT[i]);
+    sink += sum;
+  });
+}
+
 // Ours, as streams: runs of kMaxPacketRays consecutive rays of the set (neighbouring pixels' secondary rays) through
 // vox::tracePacket / vox::occludedPacket, which trace rays that share no travel direction one by one.
 void voxPackets(const vox::Accel& accel, const RaySet& set, std::vector<vox::Hit>& out) {
@@ -498,8 +533,15 @@ void benchIncoherent(const std::string& path, unsigned threads, uint32_t size, i
     methods.push_back({"ours double only", [&] { voxTrace(byId, set, byIdHits); }});
     std::vector<vox::Hit> packetHits(set.rays.size());
     methods.push_back({"ours packets", [&] { voxPackets(accel, set, packetHits); }});
+    std::vector<vox::Hit> textbookHits(set.rays.size());
+    methods.push_back({"textbook", [&] { textbookTrace(accel, set, textbookHits); }});
+    std::vector<double> stopT(set.rays.size());  // where the walk alone stops: the nearest hit, as traceRay finds it
+    for (size_t i = 0; i < set.rays.size(); ++i) stopT[i] = vox::traceRay(accel, set.rays[i]).t;
+    std::atomic<uint64_t> sink{0};
+    methods.push_back({"textbook walk alone", [&] { textbookWalk(accel, set, stopT, sink); }});
     timeInTurns(methods, reps);
     const uint64_t packetDiff = differingHits(ours, packetHits), byIdDiff = differingHits(ours, byIdHits);
+    const uint64_t textbookDiff = differingHits(ours, textbookHits);
     const Agreement a = compareWithEmbree(set, ours, e, diag);
     uint64_t checked = 0;
     const uint64_t bruteDiff =
@@ -511,14 +553,17 @@ void benchIncoherent(const std::string& path, unsigned threads, uint32_t size, i
     std::printf(
         "  %-11s %10s %8.2f M %10.2f M %12.3f %8.3f %8.3f %8.3f%% %8.3f%% %9llu %llu/%llu  %.1f cells, %.1f tests "
         "(%.2f in double)"
-        "  double only: %.3f (cpu %.3f), %llu differ  packets/embree: %.3f, %llu differ\n",
+        "  double only: %.3f (cpu %.3f), %llu differ  packets/embree: %.3f, %llu differ"
+        "  textbook/embree: %.3f (walk alone %.3f), %llu differ\n",
         set.name.c_str(), set.occlusion ? "occluded" : "closest", n / methods[0].median() / 1e6,
         n / methods[1].median() / 1e6, methods[0].median() / methods[1].median(), methods[0].best / methods[1].best,
         methods[0].median(true) / methods[1].median(true), 100.0 * a.same / n, 100.0 * a.closeT / n,
         (unsigned long long)a.mismatch, (unsigned long long)bruteDiff, (unsigned long long)checked,
         double(st.cells) / st.rays, double(st.tests + st.filtered) / st.rays, double(st.tests) / st.rays,
         methods[2].median() / methods[1].median(), methods[2].median(true) / methods[1].median(true),
-        (unsigned long long)byIdDiff, methods[0].median() / methods[3].median(), (unsigned long long)packetDiff);
+        (unsigned long long)byIdDiff, methods[0].median() / methods[3].median(), (unsigned long long)packetDiff,
+        methods[0].median() / methods[4].median(), methods[0].median() / methods[5].median(),
+        (unsigned long long)textbookDiff);
     std::fflush(stdout);
   }
 }

@@ -491,37 +491,49 @@ struct ExposedSurface {
   std::vector<Square> squares;
 };
 
-ExposedSurface buildExposed(const Voxels& vox, const Lattice& lat) {
-  const PointTables& tables = pointTables();
-  for (int a = 0; a < 3; ++a)
-    if (lat.dims[a] >= (uint32_t(1) << (kKeyBits + kBrickBits)) - 2 * kBrick)
-      fail<LimitError>("voxel mesh: grid dimension ", lat.dims[a], " too large for export");
-  const BrickSet set = buildBricks(vox, lat.dims);
+// The bricks owning lattice points of the voxels' corners, sorted by key: lattice point (i,j,k) belongs to brick
+// (i,j,k) >> 3, and the corners of a voxel reach one brick up on each axis.
+struct WorkBricks {
+  std::vector<uint64_t> keys;
+  std::unordered_map<uint64_t, uint32_t> index;  // key -> position in keys
+};
 
-  // Bricks owning lattice points: lattice point (i,j,k) belongs to brick (i,j,k) >> 3, and the corners of a voxel
-  // reach one brick up on each axis.
-  std::vector<uint64_t> workKeys;
-  workKeys.reserve(set.bricks.size() * 8);
+WorkBricks workBricks(const BrickSet& set) {
+  WorkBricks work;
+  work.keys.reserve(set.bricks.size() * 8);
   for (const Brick& b : set.bricks) {
     const auto c = brickCoords(b.key);
     for (int d = 0; d < 8; ++d)
-      workKeys.push_back(
+      work.keys.push_back(
           brickKey(uint64_t(c[0] + (d & 1)), uint64_t(c[1] + ((d >> 1) & 1)), uint64_t(c[2] + (d >> 2))));
   }
-  tbb::parallel_sort(workKeys.begin(), workKeys.end());
-  workKeys.erase(std::unique(workKeys.begin(), workKeys.end()), workKeys.end());
-  std::unordered_map<uint64_t, uint32_t> workIndex;
-  workIndex.reserve(workKeys.size() * 2);
-  for (uint32_t w = 0; w < workKeys.size(); ++w) workIndex.emplace(workKeys[w], w);
-  const size_t nWork = workKeys.size();
+  tbb::parallel_sort(work.keys.begin(), work.keys.end());
+  work.keys.erase(std::unique(work.keys.begin(), work.keys.end()), work.keys.end());
+  work.index.reserve(work.keys.size() * 2);
+  for (uint32_t w = 0; w < work.keys.size(); ++w) work.index.emplace(work.keys[w], w);
+  return work;
+}
 
-  // Pass 1: vertices per lattice point (one per cycle), numbered brick by brick.
-  std::vector<std::array<uint16_t, 512>> firstLocal(nWork);
-  std::vector<uint64_t> vertexBase(nWork + 1, 0);
+// The vertices' numbers: one vertex per cycle of a lattice point, numbered brick by brick. The vertices of local
+// point l of work brick w are base[w] + firstLocal[w][l] up to the next point's first.
+struct VertexNumbering {
+  std::vector<std::array<uint16_t, 512>> firstLocal;
+  std::vector<uint64_t> base;  // one more than the work bricks: base.back() is the vertex count
+  uint32_t count(size_t w, int l) const {
+    const uint32_t end = l + 1 < 512 ? firstLocal[w][l + 1] : uint32_t(base[w + 1] - base[w]);
+    return end - firstLocal[w][l];
+  }
+};
+
+VertexNumbering numberVertices(const BrickSet& set, const WorkBricks& work, const PointTables& tables) {
+  const size_t nWork = work.keys.size();
+  VertexNumbering num;
+  num.firstLocal.resize(nWork);
+  num.base.assign(nWork + 1, 0);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nWork), [&](const tbb::blocked_range<size_t>& r) {
     Pad pad;
     for (size_t w = r.begin(); w != r.end(); ++w) {
-      const auto bc = brickCoords(workKeys[w]);
+      const auto bc = brickCoords(work.keys[w]);
       pad.fill(set, bc[0], bc[1], bc[2]);
       uint32_t running = 0;
       for (int z = 0; z < kBrick; ++z)
@@ -529,106 +541,147 @@ ExposedSurface buildExposed(const Voxels& vox, const Lattice& lat) {
           // A row of lattice points without any voxel around it has no vertex.
           const bool empty = (pad.row(y - 1, z - 1) | pad.row(y, z - 1) | pad.row(y - 1, z) | pad.row(y, z)) == 0;
           for (int x = 0; x < kBrick; ++x) {
-            firstLocal[w][x + 8 * y + 64 * z] = uint16_t(running);
+            num.firstLocal[w][x + 8 * y + 64 * z] = uint16_t(running);
             if (!empty) {
               const int occ = pad.octants(x, y, z);
               if (occ != 0 && occ != 255) running += tables.cycleCount[pad.config(x, y, z, tables)];
             }
           }
         }
-      vertexBase[w + 1] = running;
+      num.base[w + 1] = running;
     }
   });
-  for (size_t w = 0; w < nWork; ++w) vertexBase[w + 1] += vertexBase[w];
-  checkVertexCount(vertexBase[nWork]);
+  for (size_t w = 0; w < nWork; ++w) num.base[w + 1] += num.base[w];
+  checkVertexCount(num.base[nWork]);
+  return num;
+}
+
+// The vertex ids at the corners of one brick's voxels, local lattice coordinates 0..kBrick: the corners at kBrick
+// belong to the upper neighbours (`owner`, work-brick indices by d = dx | dy << 1 | dz << 2). Configurations are
+// computed once per point.
+class BrickVertexIds {
+ public:
+  BrickVertexIds(const Pad& pad, const PointTables& tables, const VertexNumbering& num,
+                 const std::array<uint32_t, 8>& owner)
+      : pad_(pad), tables_(tables), num_(num), owner_(owner) {
+    configCache_.fill(-1);
+  }
+  uint32_t operator()(const int q[3], int slot) {
+    const int ci = q[0] + (kBrick + 1) * (q[1] + (kBrick + 1) * q[2]);
+    if (configCache_[ci] < 0) configCache_[ci] = pad_.config(q[0], q[1], q[2], tables_);
+    const uint8_t cyc = tables_.cycle[configCache_[ci]][slot];
+    VOX_CHECK(cyc != kNoCycle);
+    const int d = (q[0] >> kBrickBits) | ((q[1] >> kBrickBits) << 1) | ((q[2] >> kBrickBits) << 2);
+    const int l = (q[0] & 7) | ((q[1] & 7) << 3) | ((q[2] & 7) << 6);
+    return uint32_t(num_.base[owner_[d]] + num_.firstLocal[owner_[d]][l] + cyc);
+  }
+
+ private:
+  const Pad& pad_;
+  const PointTables& tables_;
+  const VertexNumbering& num_;
+  const std::array<uint32_t, 8>& owner_;
+  std::array<int32_t, (kBrick + 1) * (kBrick + 1) * (kBrick + 1)> configCache_;
+};
+
+// The exposed squares of one brick's voxels (origin: its first cell), with their vertex ids, appended to `squares`.
+void brickSquares(const Brick& brick, const BrickSet& set, const Pad& pad, const std::array<int64_t, 3>& origin,
+                  BrickVertexIds& vertexId, std::vector<Square>& squares) {
+  uint32_t rank = 0;
+  for (int z = 0; z < kBrick; ++z)
+    for (uint64_t bits = brick.mask[z]; bits; bits &= bits - 1, ++rank) {
+      const int bit = std::countr_zero(bits);
+      const int cellLocal[3] = {bit & 7, bit >> 3, z};
+      const uint32_t color = set.colors[brick.firstVoxel + rank];
+      for (int a = 0; a < 3; ++a)
+        for (int positive = 0; positive < 2; ++positive) {
+          int n[3] = {cellLocal[0], cellLocal[1], cellLocal[2]};
+          n[a] += positive ? 1 : -1;
+          if (pad.at(n[0], n[1], n[2])) continue;
+          const int b = (a + 1) % 3, c = (a + 2) % 3;
+          Square s;
+          s.color = color;
+          s.axis = uint8_t(a);
+          s.positive = uint8_t(positive);
+          s.plane = uint32_t(origin[a] + cellLocal[a] + positive);
+          s.u = uint32_t(origin[b] + cellLocal[b]);
+          s.v = uint32_t(origin[c] + cellLocal[c]);
+          static constexpr int kCorner[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+          for (int k = 0; k < 4; ++k) {
+            const int du = kCorner[k][0], dv = kCorner[k][1];
+            int q[3];
+            q[a] = cellLocal[a] + positive;
+            q[b] = cellLocal[b] + du;
+            q[c] = cellLocal[c] + dv;
+            // Seen from corner q the square lies towards -b when du = 1, towards +b when du = 0.
+            s.vid[k] = vertexId(q, slotOf(a, 1 - du, 1 - dv));
+          }
+          squares.push_back(s);
+        }
+    }
+}
+
+// The positions of work brick w's vertices (every vertex of a lattice point at the point), and whether a point has
+// several.
+void placeVertices(size_t w, const VertexNumbering& num, const Lattice& lat, const std::array<int64_t, 3>& origin,
+                   ExposedSurface& out) {
+  for (int l = 0; l < 512; ++l) {
+    const uint32_t count = num.count(w, l);
+    if (count == 0) continue;
+    const Vec3 p = lat.point(uint64_t(origin[0] + (l & 7)), uint64_t(origin[1] + ((l >> 3) & 7)),
+                             uint64_t(origin[2] + (l >> 6)));
+    const uint64_t first = num.base[w] + num.firstLocal[w][l];
+    for (uint32_t c = 0; c < count; ++c) {
+      out.positions[first + c] = p;
+      out.split[first + c] = count > 1;
+    }
+  }
+}
+
+// The lists of squares one after another, in order, each freed once copied.
+std::vector<Square> concatenate(std::vector<std::vector<Square>>& lists) {
+  std::vector<size_t> offset(lists.size() + 1, 0);
+  for (size_t w = 0; w < lists.size(); ++w) offset[w + 1] = offset[w] + lists[w].size();
+  std::vector<Square> all(offset.back());
+  tbb::parallel_for(size_t(0), lists.size(), [&](size_t w) {
+    std::copy(lists[w].begin(), lists[w].end(), all.begin() + ptrdiff_t(offset[w]));
+    std::vector<Square>().swap(lists[w]);
+  });
+  return all;
+}
+
+ExposedSurface buildExposed(const Voxels& vox, const Lattice& lat) {
+  const PointTables& tables = pointTables();
+  for (int a = 0; a < 3; ++a)
+    if (lat.dims[a] >= (uint32_t(1) << (kKeyBits + kBrickBits)) - 2 * kBrick)
+      fail<LimitError>("voxel mesh: grid dimension ", lat.dims[a], " too large for export");
+  const BrickSet set = buildBricks(vox, lat.dims);
+  const WorkBricks work = workBricks(set);
+  const size_t nWork = work.keys.size();
+  const VertexNumbering num = numberVertices(set, work, tables);
 
   ExposedSurface out;
-  out.positions.resize(vertexBase[nWork]);
-  out.split.resize(vertexBase[nWork]);
+  out.positions.resize(num.base[nWork]);
+  out.split.resize(num.base[nWork]);
   std::vector<std::vector<Square>> perBrick(nWork);
-
-  // Pass 2: vertex positions, and the exposed squares of each brick's voxels with their vertex ids.
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nWork), [&](const tbb::blocked_range<size_t>& r) {
     Pad pad;
-    std::array<int32_t, (kBrick + 1) * (kBrick + 1) * (kBrick + 1)> configCache;
     for (size_t w = r.begin(); w != r.end(); ++w) {
-      const auto bc = brickCoords(workKeys[w]);
+      const auto bc = brickCoords(work.keys[w]);
       pad.fill(set, bc[0], bc[1], bc[2]);
-      const int64_t ox = bc[0] * kBrick, oy = bc[1] * kBrick, oz = bc[2] * kBrick;
-      for (int l = 0; l < 512; ++l) {
-        const uint32_t first = firstLocal[w][l];
-        const uint32_t end = l + 1 < 512 ? firstLocal[w][l + 1] : uint32_t(vertexBase[w + 1] - vertexBase[w]);
-        if (first == end) continue;
-        const Vec3 p = lat.point(uint64_t(ox + (l & 7)), uint64_t(oy + ((l >> 3) & 7)), uint64_t(oz + (l >> 6)));
-        for (uint32_t c = first; c < end; ++c) {
-          out.positions[vertexBase[w] + c] = p;
-          out.split[vertexBase[w] + c] = end - first > 1;
-        }
-      }
-      auto occIt = set.index.find(workKeys[w]);
+      const std::array<int64_t, 3> origin = {bc[0] * kBrick, bc[1] * kBrick, bc[2] * kBrick};
+      placeVertices(w, num, lat, origin, out);
+      const auto occIt = set.index.find(work.keys[w]);
       if (occIt == set.index.end()) continue;
-      const Brick& brick = set.bricks[occIt->second];
-      // Work-brick indices of this brick and its upper neighbours, which own the corners at local coordinate 8.
       std::array<uint32_t, 8> owner;
-      for (int d = 0; d < 8; ++d) {
-        auto it = workIndex.find(
+      for (int d = 0; d < 8; ++d)  // present by construction of the work bricks
+        owner[d] = work.index.at(
             brickKey(uint64_t(bc[0] + (d & 1)), uint64_t(bc[1] + ((d >> 1) & 1)), uint64_t(bc[2] + (d >> 2))));
-        owner[d] = it->second;  // present by construction of workKeys
-      }
-      configCache.fill(-1);
-      auto vertexId = [&](int q[3], int slot) {
-        const int ci = q[0] + (kBrick + 1) * (q[1] + (kBrick + 1) * q[2]);
-        if (configCache[ci] < 0) configCache[ci] = pad.config(q[0], q[1], q[2], tables);
-        const uint8_t cyc = tables.cycle[configCache[ci]][slot];
-        VOX_CHECK(cyc != kNoCycle);
-        const int d = (q[0] >> kBrickBits) | ((q[1] >> kBrickBits) << 1) | ((q[2] >> kBrickBits) << 2);
-        const int l = (q[0] & 7) | ((q[1] & 7) << 3) | ((q[2] & 7) << 6);
-        return uint32_t(vertexBase[owner[d]] + firstLocal[owner[d]][l] + cyc);
-      };
-      std::vector<Square>& squares = perBrick[w];
-      uint32_t rank = 0;
-      for (int z = 0; z < kBrick; ++z)
-        for (uint64_t bits = brick.mask[z]; bits; bits &= bits - 1, ++rank) {
-          const int bit = std::countr_zero(bits);
-          const int cellLocal[3] = {bit & 7, bit >> 3, z};
-          const uint32_t color = set.colors[brick.firstVoxel + rank];
-          for (int a = 0; a < 3; ++a)
-            for (int positive = 0; positive < 2; ++positive) {
-              int n[3] = {cellLocal[0], cellLocal[1], cellLocal[2]};
-              n[a] += positive ? 1 : -1;
-              if (pad.at(n[0], n[1], n[2])) continue;
-              const int b = (a + 1) % 3, c = (a + 2) % 3;
-              Square s;
-              s.color = color;
-              s.axis = uint8_t(a);
-              s.positive = uint8_t(positive);
-              const int64_t origin[3] = {ox, oy, oz};
-              s.plane = uint32_t(origin[a] + cellLocal[a] + positive);
-              s.u = uint32_t(origin[b] + cellLocal[b]);
-              s.v = uint32_t(origin[c] + cellLocal[c]);
-              static constexpr int kCorner[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-              for (int k = 0; k < 4; ++k) {
-                const int du = kCorner[k][0], dv = kCorner[k][1];
-                int q[3];
-                q[a] = cellLocal[a] + positive;
-                q[b] = cellLocal[b] + du;
-                q[c] = cellLocal[c] + dv;
-                // Seen from corner q the square lies towards -b when du = 1, towards +b when du = 0.
-                s.vid[k] = vertexId(q, slotOf(a, 1 - du, 1 - dv));
-              }
-              squares.push_back(s);
-            }
-        }
+      BrickVertexIds vertexId(pad, tables, num, owner);
+      brickSquares(set.bricks[occIt->second], set, pad, origin, vertexId, perBrick[w]);
     }
   });
-
-  std::vector<size_t> offset(nWork + 1, 0);
-  for (size_t w = 0; w < nWork; ++w) offset[w + 1] = offset[w] + perBrick[w].size();
-  out.squares.resize(offset[nWork]);
-  tbb::parallel_for(size_t(0), nWork, [&](size_t w) {
-    std::copy(perBrick[w].begin(), perBrick[w].end(), out.squares.begin() + ptrdiff_t(offset[w]));
-    std::vector<Square>().swap(perBrick[w]);
-  });
+  out.squares = concatenate(perBrick);
   return out;
 }
 

@@ -628,8 +628,8 @@ void placeVertices(size_t w, const VertexNumbering& num, const Lattice& lat, con
   for (int l = 0; l < 512; ++l) {
     const uint32_t count = num.count(w, l);
     if (count == 0) continue;
-    const Vec3 p = lat.point(uint64_t(origin[0] + (l & 7)), uint64_t(origin[1] + ((l >> 3) & 7)),
-                             uint64_t(origin[2] + (l >> 6)));
+    const Vec3 p =
+        lat.point(uint64_t(origin[0] + (l & 7)), uint64_t(origin[1] + ((l >> 3) & 7)), uint64_t(origin[2] + (l >> 6)));
     const uint64_t first = num.base[w] + num.firstLocal[w][l];
     for (uint32_t c = 0; c < count; ++c) {
       out.positions[first + c] = p;

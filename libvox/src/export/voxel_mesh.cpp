@@ -749,159 +749,168 @@ void triangulateRectangle(const std::vector<uint32_t>& poly, const std::vector<V
 // ---------------------------------------------------------------------------------------------------------------
 // FaceMode::Merged: greedy meshing of each plane's squares into rectangles of one colour.
 
-VoxelMesh mergedMesh(ExposedSurface&& surface, const std::array<uint32_t, 3>& dims, bool colored) {
-  std::vector<Square>& sq = surface.squares;
-  // Bucket the squares by plane (axis, orientation, position) with a counting sort: the number of planes grows with
-  // the grid's side, not its volume.
+// The squares bucketed by plane (axis, orientation, position) with a counting sort (the number of planes grows with
+// the grid's side, not its volume): plane p's squares are order[planeStart[p], planeStart[p + 1]), keyed for sorting
+// by (v, u), so that the greedy scan and its row lookups touch the squares themselves only to read vertices.
+struct PlaneEntry {
+  uint64_t key;  // v << 32 | u
+  uint32_t color;
+  uint32_t idx;  // in the squares
+};
+struct PlaneBuckets {
+  std::vector<PlaneEntry> order;
+  std::vector<uint32_t> planeStart;
+  std::vector<size_t> planes;  // the planes holding squares
+};
+
+PlaneBuckets bucketByPlane(const std::vector<Square>& sq, const std::array<uint32_t, 3>& dims) {
   std::array<size_t, 4> axisBase{};
   for (int a = 0; a < 3; ++a) axisBase[a + 1] = axisBase[a] + 2 * (size_t(dims[a]) + 1);
   const size_t nPlanes = axisBase[3];
   auto planeOf = [&](const Square& s) { return axisBase[s.axis] + 2 * size_t(s.plane) + s.positive; };
-  std::vector<uint32_t> planeStart(nPlanes + 1, 0);
-  for (const Square& s : sq) ++planeStart[planeOf(s) + 1];
-  for (size_t p = 0; p < nPlanes; ++p) planeStart[p + 1] += planeStart[p];
-  // Within a plane, squares sorted by (v, u): a contiguous array of keys, so the greedy scan and its row lookups
-  // touch the squares themselves only to compare colours and read vertices.
-  struct Entry {
-    uint64_t key;  // v << 32 | u
-    uint32_t color;
-    uint32_t idx;
-  };
-  std::vector<Entry> order(sq.size());
-  {
-    std::vector<uint32_t> cursor(planeStart.begin(), planeStart.end() - 1);
-    for (uint32_t i = 0; i < sq.size(); ++i)
-      order[cursor[planeOf(sq[i])]++] = {(uint64_t(sq[i].v) << 32) | sq[i].u, sq[i].color, i};
-  }
-  std::vector<size_t> planes;
+  PlaneBuckets out;
+  out.planeStart.assign(nPlanes + 1, 0);
+  for (const Square& s : sq) ++out.planeStart[planeOf(s) + 1];
+  for (size_t p = 0; p < nPlanes; ++p) out.planeStart[p + 1] += out.planeStart[p];
+  out.order.resize(sq.size());
+  std::vector<uint32_t> cursor(out.planeStart.begin(), out.planeStart.end() - 1);
+  for (uint32_t i = 0; i < sq.size(); ++i)
+    out.order[cursor[planeOf(sq[i])]++] = {(uint64_t(sq[i].v) << 32) | sq[i].u, sq[i].color, i};
   for (size_t p = 0; p < nPlanes; ++p)
-    if (planeStart[p + 1] > planeStart[p]) planes.push_back(p);
+    if (out.planeStart[p + 1] > out.planeStart[p]) out.planes.push_back(p);
+  return out;
+}
 
-  // Each plane yields polygons; each polygon lists its boundary vertices and remembers which are its four corners.
-  struct PlaneOut {
-    std::vector<uint32_t> start{0};
-    std::vector<uint32_t> verts;
-    std::vector<uint8_t> corner;
-    std::vector<uint32_t> colors;
+// The polygons of one plane: each lists its boundary vertices and marks which are its four corners.
+struct PlanePolygons {
+  std::vector<uint32_t> start{0};
+  std::vector<uint32_t> verts;
+  std::vector<uint8_t> corner;
+  std::vector<uint32_t> colors;
+};
+
+// Appends the boundary of the w x h rectangle whose rows start at squares e[rowStart[r]], counter-clockwise about
+// +axis in (u, v) (along v = 0, u = w, v = h, u = 0), reversed for a plane facing down its axis.
+void addRectangle(const PlaneEntry* e, const std::vector<size_t>& rowStart, uint32_t w, const std::vector<Square>& sq,
+                  uint32_t color, bool positive, PlanePolygons& po) {
+  const uint32_t h = uint32_t(rowStart.size());
+  auto vertexAt = [&](uint32_t du, uint32_t dv) {
+    const uint32_t cu = std::min(du, w - 1), cv = std::min(dv, h - 1);
+    const Square& s = sq[e[rowStart[cv] + cu].idx];
+    const int k = (du - cu) + 2 * (dv - cv);  // corner (du-cu, dv-cv): 0 -> 00, 1 -> 10, 3 -> 11, 2 -> 01
+    static constexpr int kCornerIndex[4] = {0, 1, 3, 2};
+    return s.vid[kCornerIndex[k]];
   };
-  std::vector<PlaneOut> outs(planes.size());
-  tbb::parallel_for(size_t(0), planes.size(), [&](size_t pi) {
-    const size_t p = planes[pi];
-    Entry* const e = order.data() + planeStart[p];
-    const size_t n = planeStart[p + 1] - planeStart[p];
-    std::sort(e, e + n, [](const Entry& x, const Entry& y) { return x.key < y.key; });
-    std::vector<uint8_t> used(n, 0);
-    auto findSquare = [&](size_t from, uint64_t key) -> size_t {
-      const Entry* it = std::lower_bound(e + from, e + n, key, [](const Entry& x, uint64_t k) { return x.key < k; });
-      return it != e + n && it->key == key ? size_t(it - e) : n;
-    };
-    // Squares (i + k) continue the row of square i with the same colour, unused.
-    auto extends = [&](size_t j, uint64_t key, uint32_t color) {
-      return j < n && !used[j] && e[j].key == key && e[j].color == color;
-    };
-    PlaneOut& po = outs[pi];
-    std::vector<size_t> rowStart;
-    for (size_t i = 0; i < n; ++i) {
-      if (used[i]) continue;
-      const uint32_t color = e[i].color;
-      const bool positive = sq[e[i].idx].positive;
-      uint32_t w = 1;
-      while (extends(i + w, e[i].key + w, color)) ++w;
-      rowStart.assign(1, i);
-      for (;;) {
-        const uint64_t rowKey = e[i].key + (uint64_t(rowStart.size()) << 32);
-        const size_t j = findSquare(i, rowKey);
-        bool ok = j < n;
-        for (uint32_t k = 0; k < w && ok; ++k) ok = extends(j + k, rowKey + k, color);
-        if (!ok) break;
-        rowStart.push_back(j);
-      }
-      const uint32_t h = uint32_t(rowStart.size());
-      for (size_t r = 0; r < h; ++r)
-        std::fill(used.begin() + ptrdiff_t(rowStart[r]), used.begin() + ptrdiff_t(rowStart[r] + w), 1);
-      // Boundary lattice points counter-clockwise about +axis in (u, v): along v = 0, u = w, v = h, u = 0.
-      auto vertexAt = [&](uint32_t du, uint32_t dv) {
-        const uint32_t cu = std::min(du, w - 1), cv = std::min(dv, h - 1);
-        const Square& s = sq[e[rowStart[cv] + cu].idx];
-        const int k = (du - cu) + 2 * (dv - cv);  // corner (du-cu, dv-cv): 0 -> 00, 1 -> 10, 3 -> 11, 2 -> 01
-        static constexpr int kCornerIndex[4] = {0, 1, 3, 2};
-        return s.vid[kCornerIndex[k]];
-      };
-      const size_t begin = po.verts.size();
-      for (uint32_t u = 0; u < w; ++u) po.verts.push_back(vertexAt(u, 0)), po.corner.push_back(u == 0);
-      for (uint32_t v = 0; v < h; ++v) po.verts.push_back(vertexAt(w, v)), po.corner.push_back(v == 0);
-      for (uint32_t u = w; u > 0; --u) po.verts.push_back(vertexAt(u, h)), po.corner.push_back(u == w);
-      for (uint32_t v = h; v > 0; --v) po.verts.push_back(vertexAt(0, v)), po.corner.push_back(v == h);
-      if (!positive) {
-        // Reverse the cycle but keep the first vertex first.
-        std::reverse(po.verts.begin() + ptrdiff_t(begin) + 1, po.verts.end());
-        std::reverse(po.corner.begin() + ptrdiff_t(begin) + 1, po.corner.end());
-      }
-      po.start.push_back(uint32_t(po.verts.size()));
-      po.colors.push_back(color);
-    }
-  });
-  std::vector<Square>().swap(sq);
+  const size_t begin = po.verts.size();
+  for (uint32_t u = 0; u < w; ++u) po.verts.push_back(vertexAt(u, 0)), po.corner.push_back(u == 0);
+  for (uint32_t v = 0; v < h; ++v) po.verts.push_back(vertexAt(w, v)), po.corner.push_back(v == 0);
+  for (uint32_t u = w; u > 0; --u) po.verts.push_back(vertexAt(u, h)), po.corner.push_back(u == w);
+  for (uint32_t v = h; v > 0; --v) po.verts.push_back(vertexAt(0, v)), po.corner.push_back(v == h);
+  if (!positive) {
+    // Reverse the cycle but keep the first vertex first.
+    std::reverse(po.verts.begin() + ptrdiff_t(begin) + 1, po.verts.end());
+    std::reverse(po.corner.begin() + ptrdiff_t(begin) + 1, po.corner.end());
+  }
+  po.start.push_back(uint32_t(po.verts.size()));
+  po.colors.push_back(color);
+}
 
-  // Keep the vertices that are a corner of some rectangle; the others lie inside a rectangle or straight along
-  // the sides of all their rectangles (then they have two faces), and dropping them leaves no T-junction. Split
-  // lattice points stay: where two sheets run along the same lattice line (two voxels meeting along a row of
-  // edges), dropping their vertices would give both sheets the same long edge, with four faces.
-  const size_t nv = surface.positions.size();
+// Greedy meshing of one plane's n squares e[0, n) (sorted here by key) into rectangles of one colour: from the first
+// unused square, the longest row of its colour, then as many rows above it as continue it whole.
+PlanePolygons mergePlane(PlaneEntry* const e, size_t n, const std::vector<Square>& sq) {
+  std::sort(e, e + n, [](const PlaneEntry& x, const PlaneEntry& y) { return x.key < y.key; });
+  std::vector<uint8_t> used(n, 0);
+  auto findSquare = [&](size_t from, uint64_t key) -> size_t {
+    const PlaneEntry* it =
+        std::lower_bound(e + from, e + n, key, [](const PlaneEntry& x, uint64_t k) { return x.key < k; });
+    return it != e + n && it->key == key ? size_t(it - e) : n;
+  };
+  // Square j continues a row at `key` with the same colour, unused.
+  auto extends = [&](size_t j, uint64_t key, uint32_t color) {
+    return j < n && !used[j] && e[j].key == key && e[j].color == color;
+  };
+  PlanePolygons po;
+  std::vector<size_t> rowStart;
+  for (size_t i = 0; i < n; ++i) {
+    if (used[i]) continue;
+    const uint32_t color = e[i].color;
+    uint32_t w = 1;
+    while (extends(i + w, e[i].key + w, color)) ++w;
+    rowStart.assign(1, i);
+    for (;;) {
+      const uint64_t rowKey = e[i].key + (uint64_t(rowStart.size()) << 32);
+      const size_t j = findSquare(i, rowKey);
+      bool ok = j < n;
+      for (uint32_t k = 0; k < w && ok; ++k) ok = extends(j + k, rowKey + k, color);
+      if (!ok) break;
+      rowStart.push_back(j);
+    }
+    for (size_t r : rowStart) std::fill(used.begin() + ptrdiff_t(r), used.begin() + ptrdiff_t(r + w), 1);
+    addRectangle(e, rowStart, w, sq, color, sq[e[i].idx].positive, po);
+  }
+  return po;
+}
+
+// The new ids of the vertices kept (newId[v + 1] > newId[v] when v is kept): those that are a corner of some
+// rectangle; the others lie inside a rectangle or straight along the sides of all their rectangles (then they have
+// two faces), and dropping them leaves no T-junction. Split lattice points stay: where two sheets run along the same
+// lattice line (two voxels meeting along a row of edges), dropping their vertices would give both sheets the same
+// long edge, with four faces.
+std::vector<uint32_t> keptVertexIds(const std::vector<uint8_t>& split, const std::vector<PlanePolygons>& outs) {
+  const size_t nv = split.size();
   std::vector<std::atomic<uint8_t>> keep(nv);
   for (size_t v = 0; v < nv; ++v)
-    if (surface.split[v]) keep[v].store(1, std::memory_order_relaxed);
+    if (split[v]) keep[v].store(1, std::memory_order_relaxed);
   tbb::parallel_for(size_t(0), outs.size(), [&](size_t pi) {
-    const PlaneOut& po = outs[pi];
+    const PlanePolygons& po = outs[pi];
     for (size_t k = 0; k < po.verts.size(); ++k)
       if (po.corner[k]) keep[po.verts[k]].store(1, std::memory_order_relaxed);
   });
   std::vector<uint32_t> newId(nv + 1, 0);
   for (size_t v = 0; v < nv; ++v) newId[v + 1] = newId[v] + keep[v].load(std::memory_order_relaxed);
-  VoxelMesh mesh;
-  mesh.positions.resize(newId[nv]);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t v = r.begin(); v != r.end(); ++v)
-      if (keep[v].load(std::memory_order_relaxed)) mesh.positions[newId[v]] = surface.positions[v];
-  });
+  return newId;
+}
 
-  // A rectangle left with its four corners is one quad; one whose sides still carry vertices becomes triangles
-  // without zero-area triangles. Polygons with collinear vertices are what MeshLab (2020.09) triangulates into
-  // zero-area triangles, then reporting non-manifold edges, and what assimp (5.2) fails to triangulate ("no ear
-  // found"): issue 10.
-  std::vector<size_t> faceOffset(outs.size() + 1, 0), vertOffset(outs.size() + 1, 0);
-  std::vector<std::vector<uint32_t>> kept(outs.size());
-  tbb::parallel_for(size_t(0), outs.size(), [&](size_t pi) {
-    PlaneOut& po = outs[pi];
-    std::vector<uint32_t>& kv = kept[pi];
-    std::vector<uint32_t> start{0}, colors, poly, tris;
-    for (size_t f = 0; f + 1 < po.start.size(); ++f) {
-      poly.clear();
-      std::array<size_t, 4> corner{};
-      size_t corners = 0;
-      for (uint32_t k = po.start[f]; k < po.start[f + 1]; ++k) {
-        if (!keep[po.verts[k]].load(std::memory_order_relaxed)) continue;
-        if (po.corner[k]) corner[corners++] = poly.size();
-        poly.push_back(newId[po.verts[k]]);
-      }
-      VOX_CHECK(corners == 4 && corner[0] == 0);
-      if (poly.size() == 4) {
-        kv.insert(kv.end(), poly.begin(), poly.end());
-        start.push_back(uint32_t(kv.size()));
-        colors.push_back(po.colors[f]);
-        continue;
-      }
-      tris.clear();
-      triangulateRectangle(poly, mesh.positions, corner, tris);
-      for (size_t t = 0; t < tris.size(); t += 3) {
-        kv.insert(kv.end(), tris.begin() + ptrdiff_t(t), tris.begin() + ptrdiff_t(t + 3));
-        start.push_back(uint32_t(kv.size()));
-        colors.push_back(po.colors[f]);
-      }
+// One plane's polygons as faces over the kept vertices (`kv`, renumbered; po.start and po.colors become the faces'):
+// a rectangle left with its four corners is one quad; one whose sides still carry vertices becomes triangles without
+// zero-area triangles. Polygons with collinear vertices are what MeshLab (2020.09) triangulates into zero-area
+// triangles, then reporting non-manifold edges, and what assimp (5.2) fails to triangulate ("no ear found"): issue 10.
+void planeFaces(PlanePolygons& po, const std::vector<uint32_t>& newId, const std::vector<Vec3>& positions,
+                std::vector<uint32_t>& kv) {
+  std::vector<uint32_t> start{0}, colors, poly, tris;
+  for (size_t f = 0; f + 1 < po.start.size(); ++f) {
+    poly.clear();
+    std::array<size_t, 4> corner{};
+    size_t corners = 0;
+    for (uint32_t k = po.start[f]; k < po.start[f + 1]; ++k) {
+      const uint32_t v = po.verts[k];
+      if (newId[v + 1] == newId[v]) continue;  // dropped
+      if (po.corner[k]) corner[corners++] = poly.size();
+      poly.push_back(newId[v]);
     }
-    po.start = std::move(start);
-    po.colors = std::move(colors);
-  });
+    VOX_CHECK(corners == 4 && corner[0] == 0);
+    if (poly.size() == 4) {
+      kv.insert(kv.end(), poly.begin(), poly.end());
+      start.push_back(uint32_t(kv.size()));
+      colors.push_back(po.colors[f]);
+      continue;
+    }
+    tris.clear();
+    triangulateRectangle(poly, positions, corner, tris);
+    for (size_t t = 0; t < tris.size(); t += 3) {
+      kv.insert(kv.end(), tris.begin() + ptrdiff_t(t), tris.begin() + ptrdiff_t(t + 3));
+      start.push_back(uint32_t(kv.size()));
+      colors.push_back(po.colors[f]);
+    }
+  }
+  po.start = std::move(start);
+  po.colors = std::move(colors);
+}
+
+// The planes' faces one after another into `mesh` (faceStart, faceVertices, faceColors when colored).
+void gatherFaces(const std::vector<PlanePolygons>& outs, const std::vector<std::vector<uint32_t>>& kept, bool colored,
+                 VoxelMesh& mesh) {
+  std::vector<size_t> faceOffset(outs.size() + 1, 0), vertOffset(outs.size() + 1, 0);
   for (size_t pi = 0; pi < outs.size(); ++pi) {
     faceOffset[pi + 1] = faceOffset[pi] + outs[pi].colors.size();
     vertOffset[pi + 1] = vertOffset[pi] + kept[pi].size();
@@ -917,6 +926,29 @@ VoxelMesh mergedMesh(ExposedSurface&& surface, const std::array<uint32_t, 3>& di
       if (colored) mesh.faceColors[faceOffset[pi] + f] = unpackColor(outs[pi].colors[f]);
     }
   });
+}
+
+VoxelMesh mergedMesh(ExposedSurface&& surface, const std::array<uint32_t, 3>& dims, bool colored) {
+  PlaneBuckets buckets = bucketByPlane(surface.squares, dims);
+  std::vector<PlanePolygons> outs(buckets.planes.size());
+  tbb::parallel_for(size_t(0), buckets.planes.size(), [&](size_t pi) {
+    const size_t p = buckets.planes[pi];
+    outs[pi] = mergePlane(buckets.order.data() + buckets.planeStart[p],
+                          buckets.planeStart[p + 1] - buckets.planeStart[p], surface.squares);
+  });
+  std::vector<Square>().swap(surface.squares);
+
+  const std::vector<uint32_t> newId = keptVertexIds(surface.split, outs);
+  const size_t nv = surface.positions.size();
+  VoxelMesh mesh;
+  mesh.positions.resize(newId[nv]);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t v = r.begin(); v != r.end(); ++v)
+      if (newId[v + 1] > newId[v]) mesh.positions[newId[v]] = surface.positions[v];
+  });
+  std::vector<std::vector<uint32_t>> kept(outs.size());
+  tbb::parallel_for(size_t(0), outs.size(), [&](size_t pi) { planeFaces(outs[pi], newId, mesh.positions, kept[pi]); });
+  gatherFaces(outs, kept, colored, mesh);
   return mesh;
 }
 

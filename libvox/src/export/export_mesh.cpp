@@ -372,6 +372,107 @@ double srgbToLinear(uint8_t c) {
 // One triangle primitive per colour over one shared POSITION accessor, so the file keeps the mesh's shared
 // vertices (no seam cut along colour boundaries), each primitive with a matte material of its colour: glTF
 // vertex colours would force one vertex per colour at every seam.
+// The glTF model's buffer views over `buffer` (model.buffers[0] once pushed) and accessors.
+int appendView(tinygltf::Model& model, tinygltf::Buffer& buffer, const void* data, size_t bytes, int target) {
+  tinygltf::BufferView view;
+  view.buffer = 0;
+  view.byteOffset = buffer.data.size();
+  view.byteLength = bytes;
+  view.target = target;
+  const auto* b = static_cast<const unsigned char*>(data);
+  buffer.data.insert(buffer.data.end(), b, b + bytes);
+  model.bufferViews.push_back(view);
+  return int(model.bufferViews.size() - 1);
+}
+int addAccessor(tinygltf::Model& model, int view, size_t byteOffset, int componentType, int type, size_t count) {
+  tinygltf::Accessor acc;
+  acc.bufferView = view;
+  acc.byteOffset = byteOffset;
+  acc.componentType = componentType;
+  acc.type = type;
+  acc.count = count;
+  model.accessors.push_back(acc);
+  return int(model.accessors.size() - 1);
+}
+
+// A triangle mesh's vertex indices in order of colour (`order`: the faces so sorted); runs of one colour, which
+// become primitives, are idx[runStart[r], runStart[r + 1]).
+struct ColorRuns {
+  std::vector<uint32_t> order, idx;
+  std::vector<size_t> runStart{0};
+};
+ColorRuns colorRuns(const VoxelMesh& mesh) {
+  ColorRuns runs;
+  runs.order = facesByColor(mesh);
+  runs.idx.reserve(3 * runs.order.size());
+  for (size_t i = 0; i < runs.order.size(); ++i) {
+    const uint32_t f = runs.order[i];
+    if (i > 0 && mesh.hasColors() && mesh.faceColors[f] != mesh.faceColors[runs.order[i - 1]])
+      runs.runStart.push_back(runs.idx.size());
+    for (uint32_t k = mesh.faceStart[f]; k < mesh.faceStart[f + 1]; ++k) runs.idx.push_back(mesh.faceVertices[k]);
+  }
+  runs.runStart.push_back(runs.idx.size());
+  return runs;
+}
+
+// Matte: the default glTF material is fully metallic, which renders colours nearly black in viewers without an
+// environment map.
+tinygltf::Material matteMaterial(const Rgb8* color) {
+  tinygltf::Material material;
+  material.pbrMetallicRoughness.metallicFactor = 0;
+  material.pbrMetallicRoughness.roughnessFactor = 1;
+  if (color) {
+    const Rgb8& c = *color;
+    material.name = materialName(c);
+    material.pbrMetallicRoughness.baseColorFactor = {srgbToLinear(c[0]), srgbToLinear(c[1]), srgbToLinear(c[2]), 1.0};
+  } else {
+    material.name = "voxels";
+  }
+  return material;
+}
+
+// The triangle mesh (at least one face) as the model's buffer, mesh (a primitive and material per colour) and node.
+void addVoxelMesh(tinygltf::Model& model, const VoxelMesh& mesh) {
+  const size_t nv = mesh.vertexCount();
+  std::vector<float> pos(3 * nv);
+  std::vector<double> lo(3, INFINITY), hi(3, -INFINITY);
+  for (size_t v = 0; v < nv; ++v)
+    for (int a = 0; a < 3; ++a) {
+      pos[3 * v + a] = float(mesh.positions[v][a]);
+      lo[a] = std::min(lo[a], double(pos[3 * v + a]));
+      hi[a] = std::max(hi[a], double(pos[3 * v + a]));
+    }
+  const ColorRuns runs = colorRuns(mesh);
+  tinygltf::Buffer buffer;
+  const int posView = appendView(model, buffer, pos.data(), pos.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER);
+  const int posAcc = addAccessor(model, posView, 0, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, nv);
+  model.accessors[size_t(posAcc)].minValues = lo;
+  model.accessors[size_t(posAcc)].maxValues = hi;
+  const int idxView = appendView(model, buffer, runs.idx.data(), runs.idx.size() * sizeof(uint32_t),
+                                 TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+  model.buffers.push_back(std::move(buffer));
+
+  tinygltf::Mesh gm;
+  gm.name = "voxels";
+  for (size_t r = 0; r + 1 < runs.runStart.size(); ++r) {
+    tinygltf::Primitive prim;
+    prim.mode = TINYGLTF_MODE_TRIANGLES;
+    prim.attributes["POSITION"] = posAcc;
+    prim.indices =
+        addAccessor(model, idxView, runs.runStart[r] * sizeof(uint32_t), TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
+                    TINYGLTF_TYPE_SCALAR, runs.runStart[r + 1] - runs.runStart[r]);
+    model.materials.push_back(
+        matteMaterial(mesh.hasColors() ? &mesh.faceColors[runs.order[runs.runStart[r] / 3]] : nullptr));
+    prim.material = int(model.materials.size() - 1);
+    gm.primitives.push_back(prim);
+  }
+  model.meshes.push_back(gm);
+  tinygltf::Node node;
+  node.mesh = 0;
+  node.name = "voxels";
+  model.nodes.push_back(node);
+}
+
 void writeGltf(OutputFile& out, const VoxelMesh& polygons, bool binary) {
   const VoxelMesh mesh = polygons.isTriangleMesh() ? polygons : triangulateVoxelMesh(polygons);
   tinygltf::Model model;
@@ -380,87 +481,7 @@ void writeGltf(OutputFile& out, const VoxelMesh& polygons, bool binary) {
   tinygltf::Scene scene;
   scene.name = "voxels";  // also keeps an empty scene a JSON object rather than null
   if (mesh.faceCount() > 0) {
-    const size_t nv = mesh.vertexCount();
-    std::vector<float> pos(3 * nv);
-    std::vector<double> lo(3, INFINITY), hi(3, -INFINITY);
-    for (size_t v = 0; v < nv; ++v)
-      for (int a = 0; a < 3; ++a) {
-        pos[3 * v + a] = float(mesh.positions[v][a]);
-        lo[a] = std::min(lo[a], double(pos[3 * v + a]));
-        hi[a] = std::max(hi[a], double(pos[3 * v + a]));
-      }
-    // Triangles in order of colour; runs of one colour become primitives.
-    const std::vector<uint32_t> order = facesByColor(mesh);
-    std::vector<uint32_t> idx;
-    idx.reserve(3 * order.size());
-    std::vector<size_t> runStart{0};
-    for (size_t i = 0; i < order.size(); ++i) {
-      if (i > 0 && mesh.hasColors() && mesh.faceColors[order[i]] != mesh.faceColors[order[i - 1]])
-        runStart.push_back(idx.size());
-      for (uint32_t k = mesh.faceStart[order[i]]; k < mesh.faceStart[order[i] + 1]; ++k)
-        idx.push_back(mesh.faceVertices[k]);
-    }
-    runStart.push_back(idx.size());
-
-    tinygltf::Buffer buffer;
-    auto append = [&](const void* data, size_t bytes, int target) {
-      tinygltf::BufferView view;
-      view.buffer = 0;
-      view.byteOffset = buffer.data.size();
-      view.byteLength = bytes;
-      view.target = target;
-      const auto* b = static_cast<const unsigned char*>(data);
-      buffer.data.insert(buffer.data.end(), b, b + bytes);
-      model.bufferViews.push_back(view);
-      return int(model.bufferViews.size() - 1);
-    };
-    auto accessor = [&](int view, size_t byteOffset, int componentType, int type, size_t count) {
-      tinygltf::Accessor acc;
-      acc.bufferView = view;
-      acc.byteOffset = byteOffset;
-      acc.componentType = componentType;
-      acc.type = type;
-      acc.count = count;
-      model.accessors.push_back(acc);
-      return int(model.accessors.size() - 1);
-    };
-    const int posAcc = accessor(append(pos.data(), pos.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER), 0,
-                                TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, nv);
-    model.accessors[size_t(posAcc)].minValues = lo;
-    model.accessors[size_t(posAcc)].maxValues = hi;
-    const int idxView = append(idx.data(), idx.size() * sizeof(uint32_t), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
-    model.buffers.push_back(std::move(buffer));
-
-    tinygltf::Mesh gm;
-    gm.name = "voxels";
-    for (size_t r = 0; r + 1 < runStart.size(); ++r) {
-      tinygltf::Primitive prim;
-      prim.mode = TINYGLTF_MODE_TRIANGLES;
-      prim.attributes["POSITION"] = posAcc;
-      prim.indices = accessor(idxView, runStart[r] * sizeof(uint32_t), TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
-                              TINYGLTF_TYPE_SCALAR, runStart[r + 1] - runStart[r]);
-      // Matte: the default glTF material is fully metallic, which renders colours nearly black in viewers without
-      // an environment map.
-      tinygltf::Material material;
-      material.pbrMetallicRoughness.metallicFactor = 0;
-      material.pbrMetallicRoughness.roughnessFactor = 1;
-      if (mesh.hasColors()) {
-        const Rgb8& c = mesh.faceColors[order[runStart[r] / 3]];
-        material.name = materialName(c);
-        material.pbrMetallicRoughness.baseColorFactor = {srgbToLinear(c[0]), srgbToLinear(c[1]), srgbToLinear(c[2]),
-                                                         1.0};
-      } else {
-        material.name = "voxels";
-      }
-      model.materials.push_back(material);
-      prim.material = int(model.materials.size() - 1);
-      gm.primitives.push_back(prim);
-    }
-    model.meshes.push_back(gm);
-    tinygltf::Node node;
-    node.mesh = 0;
-    node.name = "voxels";
-    model.nodes.push_back(node);
+    addVoxelMesh(model, mesh);
     scene.nodes.push_back(0);
   }
   model.scenes.push_back(scene);

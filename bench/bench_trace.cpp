@@ -1,5 +1,6 @@
 // Ray throughput of the grid against Embree 3 on the same triangles, rays and thread count.
 //   bench_trace [--threads N] [--size N] [--reps N] [--factor F ...] [--incoherent [--ours-only]] [SCENE ...]
+// (--factor with --incoherent: the grid at each cells-per-triangle factor instead of the default grid)
 // Default scenes: the 40k seed bunny, the 69k Stanford bunny (PLY), the 115k SheenCloth.
 // Primary rays (default): for each scene it voxelizes (exact) at each cells-per-triangle factor and traces size x size
 // primary rays from defaultCamera(bounds) with rtcIntersect1, rtcIntersect8 (coherent context, 4x2 pixel packets),
@@ -490,7 +491,8 @@ uint64_t bruteForceDifferences(const vox::Accel& brute, const RaySet& set, const
 
 // Secondary rays of one scene on its default grid: Embree against ours, same rays, results checked.
 // `oursOnly` (--ours-only): times only our walk and checks nothing, for profiling where our time goes.
-void benchIncoherent(const std::string& path, unsigned threads, uint32_t size, int reps, bool oursOnly) {
+// `factor`: cells per triangle of the grid (dimsForFactor), or 0 for the default grid.
+void benchIncoherent(const std::string& path, unsigned threads, uint32_t size, int reps, bool oursOnly, double factor) {
   const vox::Scene scene = vox::loadScene(path);
   const vox::Box bounds = *vox::sceneBounds(scene);
   const vox::Camera cam = vox::defaultCamera(bounds);
@@ -498,7 +500,9 @@ void benchIncoherent(const std::string& path, unsigned threads, uint32_t size, i
   for (uint32_t y = 0; y < size; ++y)
     for (uint32_t x = 0; x < size; ++x)
       primary[uint64_t(y) * size + x] = vox::primaryRay(cam, size, size, x + 0.5, y + 0.5);
-  const vox::Grid grid = vox::voxelizeScene(scene, vox::VoxelizeOptions{});  // vox-voxelize's default grid
+  vox::VoxelizeOptions options;  // vox-voxelize's default grid unless a factor is given
+  if (factor > 0) options.dims = dimsForFactor(bounds, scene.triangles.size(), factor);
+  const vox::Grid grid = vox::voxelizeScene(scene, options);
   const vox::Accel accel = vox::buildAccel(scene, grid, vox::AccelKind::Grid);
   const vox::Accel brute = vox::buildAccel(scene, grid, vox::AccelKind::None);
   // The walk as before the float filter (Accel::floatCells): every triangle tested in double, read from the cell
@@ -510,8 +514,9 @@ void benchIncoherent(const std::string& path, unsigned threads, uint32_t size, i
   const double diag = vox::length(bounds.hi - bounds.lo);
 
   const char* name = std::strrchr(path.c_str(), '/') ? std::strrchr(path.c_str(), '/') + 1 : path.c_str();
-  std::printf("\n%s: %zu triangles, default grid %ux%ux%u, %zu secondary rays per set\n", name, scene.triangles.size(),
-              grid.dims[0], grid.dims[1], grid.dims[2], sets[0].rays.size());
+  std::printf("\n%s: %zu triangles, %s grid %ux%ux%u, %zu secondary rays per set\n", name, scene.triangles.size(),
+              factor > 0 ? ("cells/triangle " + std::to_string(factor).substr(0, 4)).c_str() : "default", grid.dims[0],
+              grid.dims[1], grid.dims[2], sets[0].rays.size());
   std::printf("  %-11s %10s %10s %12s %12s %8s %8s %9s %9s %9s %s\n", "set", "query", "embree", "ours", "ours/embree",
               "(best)", "(cpu)", "same", "close t", "mismatch", "brute force (diff/checked), per ray");
   for (const RaySet& set : sets) {
@@ -594,6 +599,8 @@ int main(int argc, char** argv) {
     else
       scenes.push_back(a);
   }
+  // Incoherent sets: the default grid unless factors are given.
+  const std::vector<double> incoherentFactors = factors.empty() ? std::vector<double>{0} : factors;
   if (factors.empty()) factors = {0.5, 1, 2, 3};
   // The incoherent sets read SheenCloth from its glTF sample (issue 12), the primary table from its OBJ copy.
   const std::string cloth =
@@ -613,7 +620,7 @@ int main(int argc, char** argv) {
 
   for (const std::string& path : scenes) {
     if (incoherent)
-      benchIncoherent(path, threads, size, reps, oursOnly);
+      for (double f : incoherentFactors) benchIncoherent(path, threads, size, reps, oursOnly, f);
     else
       benchPrimary(path, threads, size, reps, factors);
   }

@@ -1,5 +1,6 @@
 // Voxel meshes: the voxels of a grid (occupied and solid cells) as a polygon mesh, for vox-export (DESIGN.md,
-// "vox-export"). Building is pure geometry (voxel_mesh.cpp); writing lives in export_mesh.cpp.
+// "vox-export"). Building is pure geometry (voxel_mesh.cpp, exposed_surface.cpp, merged_mesh.cpp); writing lives in
+// export_mesh.cpp.
 #pragma once
 
 #include <array>

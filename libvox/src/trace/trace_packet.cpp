@@ -184,6 +184,264 @@ Hit alone(const Accel& accel, const Ray& ray, Query query, TraceStats* stats) {
   return occluded(accel, ray, stats) ? Hit{0, 0} : Hit{};
 }
 
+// One packet's traversal along slice axis k: the rays, the lanes of those still walking, their best hits so far
+// (best[r] for ray r) and the counters. Lanes are not zeroed: 10 KB per packet would cost more than a packet's
+// slices; see Lanes::padTail().
+struct Packet {
+  Packet(const Accel& accel_, std::span<const Ray> rays_, int k_, Query query)
+      : accel(accel_),
+        cb(accel_.boundaries),
+        rays(rays_),
+        k(k_),
+        other{(k_ + 1) % 3, (k_ + 2) % 3},
+        any(query == Query::Any),
+        forward(rays_[0].direction[k_] > 0),
+        c0(rays_[0].origin[k_]),
+        bk(cb.b[k_].data()),
+        nk(cb.dims[k_]) {
+    st.rays = rays_.size();
+  }
+  const Accel& accel;
+  const CellBoundaries& cb;
+  std::span<const Ray> rays;
+  const int k, other[2];
+  const bool any, forward;
+  const double c0;  // slab coordinates are relative to the first ray's origin on k
+  const double* const bk;
+  const int64_t nk;
+  TraceStats st;
+  Hit best[kMaxPacketRays];
+  Lanes lanes;
+  AxisBounds bounds[2];
+};
+
+// Tests ray r against the primitives every ray tests (planes, outside primitives) into p.best[r]; true when that
+// answers an occlusion query already.
+bool testAlwaysTested(Packet& p, uint32_t r) {
+  const Ray& ray = p.rays[r];
+  p.best[r] = Hit{};
+  for (uint32_t id : p.accel.alwaysTested) {
+    double t;
+    ++p.st.tests;
+    if (intersectPrimitive(p.accel, id, ray, t) && closer(t, id, p.best[r])) {
+      p.best[r] = {t, id};
+      if (p.any) break;
+    }
+  }
+  return p.any && p.best[r].valid();
+}
+
+// What the lanes cover: the span of slab coordinates within [tMin, tEnd] and the largest origin coordinates.
+struct LaneSpan {
+  double pLo = kInfinity, pHi = -kInfinity;
+  double originMax[3] = {0, 0, 0};
+};
+
+// Gives ray r a lane, unless it passes beside the grid box (its a + c s stays off the grid's range on some axis over
+// the grid's slab range; the margin covers the rounding, as in AxisBounds::cells).
+void addLane(Packet& p, uint32_t r, LaneSpan& span) {
+  const Ray& ray = p.rays[r];
+  const CellBoundaries& cb = p.cb;
+  const int k = p.k;
+  const double dk = ray.direction[k], ok = ray.origin[k];
+  const double invK = 1.0 / dk, absInv = std::fabs(invK);
+  const double shift = p.c0 - ok, cGridLo = p.bk[0] - p.c0, cGridHi = p.bk[p.nk] - p.c0;
+  double slope[2], at[2];
+  for (int q = 0; q < 2; ++q) {
+    const int u = p.other[q];
+    slope[q] = ray.direction[u] * invK;
+    at[q] = ray.origin[u] + shift * slope[q];
+    const double p0 = at[q] + cGridLo * slope[q], p1 = at[q] + cGridHi * slope[q];
+    const double reach = std::max(std::fabs(cGridLo), std::fabs(cGridHi)) * std::fabs(slope[q]);
+    const double margin =
+        positionTolerance(cb, u, std::fabs(at[q]) + std::fabs(ray.origin[u]) + std::fabs(shift * slope[q]) + reach);
+    if (std::max(p0, p1) < cb.b[u].front() - margin || std::min(p0, p1) > cb.b[u].back() + margin) return;
+  }
+  Lanes& lanes = p.lanes;
+  const uint32_t l = lanes.count++;
+  lanes.ray[l] = r;
+  lanes.ox[l] = ray.origin.x, lanes.oy[l] = ray.origin.y, lanes.oz[l] = ray.origin.z;
+  lanes.dx[l] = ray.direction.x, lanes.dy[l] = ray.direction.y, lanes.dz[l] = ray.direction.z;
+  lanes.tMin[l] = ray.tMin, lanes.tMax[l] = ray.tMax;
+  lanes.ok[l] = ok;
+  lanes.invK[l] = invK;
+  lanes.tolK[l] = positionTolerance(cb, k, ok) * absInv;
+  // At least RayAxes::hitSlack: divided by |d_k| instead of the largest |d|.
+  const double hitSlack = hitSlackLength(cb, ray.origin) * absInv;
+  const double tEnd = ray.tMax + hitSlackAt(hitSlack, ray.tMax);  // the walker's last parameter
+  lanes.hitSlack[l] = hitSlack;
+  lanes.tEnd[l] = tEnd;
+  const Hit& best = p.best[r];
+  lanes.stopAt[l] = best.valid() ? std::min(tEnd, best.t + hitSlackAt(hitSlack, best.t)) : tEnd;
+  const double pStart = ok + ray.tMin * dk, pEnd = ok + tEnd * dk;
+  span.pLo = std::min({span.pLo, pStart, pEnd});
+  span.pHi = std::max({span.pHi, pStart, pEnd});
+  for (double pos : {pStart, pEnd})
+    if (std::isfinite(pos)) span.originMax[k] = std::max(span.originMax[k], std::fabs(pos));
+  for (int q = 0; q < 2; ++q) {
+    const int u = p.other[q];
+    AxisBounds& ab = p.bounds[q];
+    lanes.s[q][l] = slope[q];
+    lanes.a[q][l] = at[q];
+    ab.magnitude =
+        std::max(ab.magnitude, std::fabs(at[q]) + std::fabs(ray.origin[u]) + std::fabs(shift) * std::fabs(slope[q]));
+    ab.sMax = std::max(ab.sMax, std::fabs(slope[q]));
+    span.originMax[u] = std::max(span.originMax[u], std::fabs(ray.origin[u]));
+  }
+}
+
+// The interval bounds of the walking lanes' a and s on both axes.
+void refreshBounds(Packet& p) {
+  const Lanes& lanes = p.lanes;
+  for (int q = 0; q < 2; ++q) {
+    AxisBounds& ab = p.bounds[q];
+    ab.aLo = ab.aHi = lanes.a[q][0];
+    ab.sLo = ab.sHi = lanes.s[q][0];
+    for (uint32_t j = 1; j < lanes.count; ++j) {
+      ab.aLo = std::min(ab.aLo, lanes.a[q][j]), ab.aHi = std::max(ab.aHi, lanes.a[q][j]);
+      ab.sLo = std::min(ab.sLo, lanes.s[q][j]), ab.sHi = std::max(ab.sHi, lanes.s[q][j]);
+    }
+  }
+}
+
+// Keeps the hits in `hitBits` (lanes, with their t in lanes.t) of primitive `id` that are closer than the lanes'
+// best; a lane with a new best stops after the slice in which its walk could still find a nearer one (an occlusion
+// query's lane after this slice).
+void recordHits(Packet& p, uint32_t id, uint64_t hitBits) {
+  Lanes& lanes = p.lanes;
+  for (; hitBits != 0; hitBits &= hitBits - 1) {
+    const uint32_t l = uint32_t(__builtin_ctzll(hitBits));
+    Hit& h = p.best[lanes.ray[l]];
+    const double t = lanes.t[l];
+    if (closer(t, id, h)) {
+      h = {t, id};
+      const double limit = t + hitSlackAt(lanes.hitSlack[l], t);
+      lanes.stopAt[l] = p.any ? -kInfinity : std::min(lanes.tEnd[l], limit);
+    }
+  }
+}
+
+// Tests the primitives of the cells ru x rv of `slice` (each once per packet, through the mailbox) against the
+// walking lanes; triangles the packet's frustum misses are skipped.
+void testCells(Packet& p, int64_t slice, const std::array<int64_t, 3>& ru, const std::array<int64_t, 3>& rv,
+               Mailbox<512>& mailbox) {
+  const Accel& accel = p.accel;
+  Lanes& lanes = p.lanes;
+  uint32_t idx[3];
+  idx[p.k] = uint32_t(slice);
+  for (int64_t j = rv[0]; j <= rv[1]; ++j) {
+    idx[p.other[1]] = uint32_t(j);
+    for (int64_t i = ru[0]; i <= ru[1]; ++i) {
+      idx[p.other[0]] = uint32_t(i);
+      ++p.st.cells;
+      const uint32_t c = accel.lookup(idx[0], idx[1], idx[2]);
+      if (c >= kSolidCell) continue;
+      for (uint32_t id : accel.cellPrims(c)) {
+        if (mailbox.seen(id)) {
+          p.st.mailboxSkips += lanes.count;
+          continue;
+        }
+        uint64_t hitBits = 0;
+        if (id < accel.triangleCount) {
+          const TriangleData& tri = accel.triangles[id];
+          if (outsidePacket(tri, p.k, p.other, p.c0, p.bounds)) continue;
+          p.st.tests += lanes.count;
+          hitBits = triangleLanes(tri, lanes);
+        } else {
+          p.st.tests += lanes.count;
+          for (uint32_t l = 0; l < lanes.count; ++l)
+            if (intersectPrimitive(accel, id, p.rays[lanes.ray[l]], lanes.t[l])) hitBits |= uint64_t(1) << l;
+        }
+        recordHits(p, id, hitBits);
+      }
+    }
+  }
+}
+
+// Retires the lanes that cannot meet anything nearer in the slices after `slice` (the stop rule of traceRay: the
+// best hit plus its slack lies before the next slice's boundary minus the exit slack), or whose walk ends before
+// them; true when any was retired.
+bool retireLanes(Packet& p, int64_t slice) {
+  Lanes& lanes = p.lanes;
+  const double boundary = p.forward ? p.bk[slice + 1] : p.bk[slice];
+  uint64_t retire = 0;
+  for (uint32_t l = 0; l < lanes.count; ++l) {
+    const double tCross = (boundary - lanes.ok[l]) * lanes.invK[l];
+    const double tNextMin = tCross - (lanes.tolK[l] + kWalkRel * std::fabs(tCross));
+    retire |= uint64_t(lanes.stopAt[l] < tNextMin) << l;
+  }
+  if (retire == 0) return false;
+  // Highest first: remove() moves the last lane into the freed one, and lanes above were already handled.
+  while (retire != 0) {
+    const uint32_t l = uint32_t(63 - __builtin_clzll(retire));
+    lanes.remove(l);
+    retire &= ~(uint64_t(1) << l);
+  }
+  return true;
+}
+
+// The last slice (in the order of travel, at most `last`) of the layer of blocks (Accel::blockSlot) holding `slice`.
+int64_t layerEnd(const Packet& p, int64_t slice, int64_t last) {
+  const int64_t blockMask = (int64_t(1) << p.accel.blockShift) - 1;
+  return p.forward ? std::min(slice | blockMask, last) : std::max(slice & ~blockMask, last);
+}
+
+// Whether every block that the packet can touch in the slices from `slice` to `end` is empty.
+bool layerEmpty(const Packet& p, int64_t slice, int64_t end) {
+  const double cA = p.bk[p.forward ? slice : slice + 1] - p.c0, cB = p.bk[p.forward ? end + 1 : end] - p.c0;
+  const auto ru = p.bounds[0].cells(p.cb, p.other[0], cA, cB);
+  const auto rv = p.bounds[1].cells(p.cb, p.other[1], cA, cB);
+  return allBlocksEmpty(p.accel, p.k, p.other, slice, ru, rv);
+}
+
+// The walk over the slices `first` to `last` of the lanes' rays, until no lane walks.
+void walkSlices(Packet& p, int64_t first, int64_t last) {
+  Lanes& lanes = p.lanes;
+  Mailbox<512> mailbox;  // per packet: more primitives than one ray meets
+  bool boundsStale = true;
+  const int64_t step = p.forward ? 1 : -1;
+  // The slices up to this one (in the order of travel) lie in a layer of blocks already found not empty.
+  int64_t checkedUpTo = first - step;
+  for (int64_t slice = first; lanes.count > 0; slice += step) {
+    if (boundsStale) refreshBounds(p);
+    boundsStale = false;
+    // Empty-space skipping: the rest of an empty layer of blocks in one step.
+    if (p.accel.blockShift != 0 && (p.forward ? slice > checkedUpTo : slice < checkedUpTo)) {
+      const int64_t end = layerEnd(p, slice, last);
+      if (layerEmpty(p, slice, end)) {
+        if (end == last) break;
+        slice = end;
+        continue;
+      }
+      checkedUpTo = end;
+    }
+    const double cA = p.bk[slice] - p.c0, cB = p.bk[slice + 1] - p.c0;
+    const auto ru = p.bounds[0].cells(p.cb, p.other[0], cA, cB);
+    const auto rv = p.bounds[1].cells(p.cb, p.other[1], cA, cB);
+    if (ru[0] > ru[1] || rv[0] > rv[1]) {
+      // Nothing here: has the packet left the grid for good?
+      const double cEnd = (p.forward ? p.bk[last + 1] : p.bk[last]) - p.c0;
+      const auto restU = p.bounds[0].cells(p.cb, p.other[0], cA, cEnd);
+      const auto restV = p.bounds[1].cells(p.cb, p.other[1], cA, cEnd);
+      if (restU[0] > restU[1] || restV[0] > restV[1]) break;
+    }
+    // A packet wide compared with the cells (a large grid, a wide tile, rays diverging far from the camera) would
+    // visit more cells per slice than its rays walking alone: let them walk alone from here. traceRay starts each
+    // ray afresh, so its answer is the same whatever this packet found so far.
+    if (ru[0] <= ru[1] && rv[0] <= rv[1] &&
+        uint64_t(ru[1] - ru[0] + 1) * uint64_t(rv[1] - rv[0] + 1) > kMaxCellsPerLane * lanes.count + 8) {
+      const Query query = p.any ? Query::Any : Query::Nearest;
+      for (uint32_t l = 0; l < lanes.count; ++l)
+        p.best[lanes.ray[l]] = alone(p.accel, p.rays[lanes.ray[l]], query, &p.st);
+      p.st.rays -= lanes.count;
+      break;
+    }
+    testCells(p, slice, ru, rv, mailbox);
+    if (slice == last) break;
+    boundsStale = retireLanes(p, slice);
+  }
+}
+
 // Up to kMaxPacketRays rays. For Query::Any a ray stops at its first hit, and hits[r] is valid exactly when the ray
 // is occluded.
 void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<Hit> hits, Query query,
@@ -193,215 +451,22 @@ void tracePacketChunk(const Accel& accel, std::span<const Ray> rays, std::span<H
     for (size_t r = 0; r < rays.size(); ++r) hits[r] = alone(accel, rays[r], query, stats);
     return;
   }
-  const bool any = query == Query::Any;
-  const int other[2] = {(k + 1) % 3, (k + 2) % 3};
-  const CellBoundaries& cb = accel.boundaries;
-  const int64_t nk = cb.dims[k];
-  const double* bk = cb.b[k].data();
-  const bool forward = rays[0].direction[k] > 0;
-  const double c0 = rays[0].origin[k];
-  const uint32_t n = uint32_t(rays.size());
-
-  TraceStats st;
-  st.rays = n;
-  Hit best[kMaxPacketRays];
-  Lanes lanes;  // not zeroed: 10 KB per packet would cost more than a packet's slices; see padTail()
-  AxisBounds bounds[2];
-  double originMax[3] = {0, 0, 0};
-  // The span of slab coordinates the rays cover within [tMin, tEnd].
-  double pLo = kInfinity, pHi = -kInfinity;
-  for (uint32_t r = 0; r < n; ++r) {
-    const Ray& ray = rays[r];
-    best[r] = Hit{};
-    for (uint32_t id : accel.alwaysTested) {
-      double t;
-      ++st.tests;
-      if (intersectPrimitive(accel, id, ray, t) && closer(t, id, best[r])) {
-        best[r] = {t, id};
-        if (any) break;
-      }
-    }
-    if (any && best[r].valid()) continue;  // occluded already: no lane
-    const uint32_t l = lanes.count++;
-    lanes.ray[l] = r;
-    lanes.ox[l] = ray.origin.x, lanes.oy[l] = ray.origin.y, lanes.oz[l] = ray.origin.z;
-    lanes.dx[l] = ray.direction.x, lanes.dy[l] = ray.direction.y, lanes.dz[l] = ray.direction.z;
-    lanes.tMin[l] = ray.tMin, lanes.tMax[l] = ray.tMax;
-    const double dk = ray.direction[k], ok = ray.origin[k];
-    const double invK = 1.0 / dk, absInv = std::fabs(invK);
-    lanes.ok[l] = ok;
-    lanes.invK[l] = invK;
-    lanes.tolK[l] = positionTolerance(cb, k, ok) * absInv;
-    // At least RayAxes::hitSlack: divided by |d_k| instead of the largest |d|.
-    const double hitSlack = hitSlackLength(cb, ray.origin) * absInv;
-    const double tEnd = ray.tMax + hitSlackAt(hitSlack, ray.tMax);  // the walker's last parameter
-    lanes.hitSlack[l] = hitSlack;
-    lanes.tEnd[l] = tEnd;
-    lanes.stopAt[l] = best[r].valid() ? std::min(tEnd, best[r].t + hitSlackAt(hitSlack, best[r].t)) : tEnd;
-    const double pStart = ok + ray.tMin * dk, pEnd = ok + tEnd * dk;
-    // A ray that passes beside the grid box needs no lane (its a + c s stays off the grid's range on some axis over
-    // the grid's slab range; the margin covers the rounding, as in AxisBounds::cells).
-    const double shift = c0 - ok, cGridLo = bk[0] - c0, cGridHi = bk[nk] - c0;
-    double slope[2], at[2];
-    bool beside = false;
-    for (int q = 0; q < 2; ++q) {
-      const int u = other[q];
-      slope[q] = ray.direction[u] * invK;
-      at[q] = ray.origin[u] + shift * slope[q];
-      const double p0 = at[q] + cGridLo * slope[q], p1 = at[q] + cGridHi * slope[q];
-      const double reach = std::max(std::fabs(cGridLo), std::fabs(cGridHi)) * std::fabs(slope[q]);
-      const double margin =
-          positionTolerance(cb, u, std::fabs(at[q]) + std::fabs(ray.origin[u]) + std::fabs(shift * slope[q]) + reach);
-      beside |= std::max(p0, p1) < cb.b[u].front() - margin || std::min(p0, p1) > cb.b[u].back() + margin;
-    }
-    if (beside) {
-      --lanes.count;
-      continue;
-    }
-    pLo = std::min({pLo, pStart, pEnd});
-    pHi = std::max({pHi, pStart, pEnd});
-    for (double p : {pStart, pEnd})
-      if (std::isfinite(p)) originMax[k] = std::max(originMax[k], std::fabs(p));
-    for (int q = 0; q < 2; ++q) {
-      const int u = other[q];
-      lanes.s[q][l] = slope[q];
-      lanes.a[q][l] = at[q];
-      bounds[q].magnitude = std::max(
-          bounds[q].magnitude, std::fabs(at[q]) + std::fabs(ray.origin[u]) + std::fabs(shift) * std::fabs(slope[q]));
-      bounds[q].sMax = std::max(bounds[q].sMax, std::fabs(slope[q]));
-      originMax[u] = std::max(originMax[u], std::fabs(ray.origin[u]));
-    }
-  }
-  for (int q = 0; q < 2; ++q) {
-    const int u = other[q];
-    bounds[q].tolPos = positionTolerance(cb, u, originMax[u]);
-  }
+  Packet p(accel, rays, k, query);
+  LaneSpan span;
+  for (uint32_t r = 0; r < rays.size(); ++r)
+    if (!testAlwaysTested(p, r)) addLane(p, r, span);  // an occluded ray needs no lane
+  for (int q = 0; q < 2; ++q) p.bounds[q].tolPos = positionTolerance(p.cb, p.other[q], span.originMax[p.other[q]]);
   // Slices to walk, in order of travel: from `first` to `last`.
-  const double padK = positionTolerance(cb, k, originMax[k]);
+  const double padK = positionTolerance(p.cb, k, span.originMax[k]);
+  const double* bk = p.bk;
   const auto range = cellRangeOnAxis(
-      nk, cb.cellsPerUnit[k], [bk](int64_t i) { return bk[i]; }, pLo - padK, pHi + padK);
-  if (range[0] > range[1]) lanes.count = 0;
-  if (lanes.count == 0) {
-    for (uint32_t r = 0; r < n; ++r) hits[r] = best[r];
-    if (stats) *stats += st;
-    return;
+      p.nk, p.cb.cellsPerUnit[k], [bk](int64_t i) { return bk[i]; }, span.pLo - padK, span.pHi + padK);
+  if (range[0] <= range[1] && p.lanes.count > 0) {
+    p.lanes.padTail();
+    walkSlices(p, p.forward ? range[0] : range[1], p.forward ? range[1] : range[0]);
   }
-  lanes.padTail();
-  const int64_t first = forward ? range[0] : range[1], last = forward ? range[1] : range[0];
-
-  Mailbox<512> mailbox;  // per packet: more primitives than one ray meets
-  bool boundsStale = true;
-  const int64_t step = forward ? 1 : -1;
-  const uint32_t shift = accel.blockShift;
-  const int64_t blockMask = (int64_t(1) << shift) - 1;
-  // The slices up to this one (in the order of travel) lie in a layer of blocks already found not empty.
-  int64_t checkedUpTo = first - step;
-  for (int64_t slice = first; lanes.count > 0; slice += step) {
-    if (boundsStale) {
-      for (int q = 0; q < 2; ++q) {
-        AxisBounds& ab = bounds[q];
-        ab.aLo = ab.aHi = lanes.a[q][0];
-        ab.sLo = ab.sHi = lanes.s[q][0];
-        for (uint32_t j = 1; j < lanes.count; ++j) {
-          ab.aLo = std::min(ab.aLo, lanes.a[q][j]), ab.aHi = std::max(ab.aHi, lanes.a[q][j]);
-          ab.sLo = std::min(ab.sLo, lanes.s[q][j]), ab.sHi = std::max(ab.sHi, lanes.s[q][j]);
-        }
-      }
-      boundsStale = false;
-    }
-    // Empty-space skipping: the slices to the end of the current layer of blocks (Accel::blockSlot) are passed over
-    // in one step when every block the packet can touch in them is empty.
-    if (shift != 0 && (forward ? slice > checkedUpTo : slice < checkedUpTo)) {
-      const int64_t layerEnd = forward ? std::min(slice | blockMask, last) : std::max(slice & ~blockMask, last);
-      const double cA = bk[forward ? slice : slice + 1] - c0, cB = bk[forward ? layerEnd + 1 : layerEnd] - c0;
-      const auto ru = bounds[0].cells(cb, other[0], cA, cB);
-      const auto rv = bounds[1].cells(cb, other[1], cA, cB);
-      if (allBlocksEmpty(accel, k, other, slice, ru, rv)) {
-        if (layerEnd == last) break;
-        slice = layerEnd;
-        continue;
-      }
-      checkedUpTo = layerEnd;
-    }
-    const double cA = bk[slice] - c0, cB = bk[slice + 1] - c0;
-    const auto ru = bounds[0].cells(cb, other[0], cA, cB);
-    const auto rv = bounds[1].cells(cb, other[1], cA, cB);
-    if (ru[0] > ru[1] || rv[0] > rv[1]) {
-      // Nothing here: has the packet left the grid for good?
-      const double cEnd = (forward ? bk[last + 1] : bk[last]) - c0;
-      const auto restU = bounds[0].cells(cb, other[0], cA, cEnd), restV = bounds[1].cells(cb, other[1], cA, cEnd);
-      if (restU[0] > restU[1] || restV[0] > restV[1]) break;
-    }
-    // A packet wide compared with the cells (a large grid, a wide tile, rays diverging far from the camera) would
-    // visit more cells per slice than its rays walking alone: let them walk alone from here. traceRay starts each
-    // ray afresh, so its answer is the same whatever this packet found so far.
-    if (ru[0] <= ru[1] && rv[0] <= rv[1] &&
-        uint64_t(ru[1] - ru[0] + 1) * uint64_t(rv[1] - rv[0] + 1) > kMaxCellsPerLane * lanes.count + 8) {
-      for (uint32_t l = 0; l < lanes.count; ++l) best[lanes.ray[l]] = alone(accel, rays[lanes.ray[l]], query, &st);
-      st.rays -= lanes.count;
-      break;
-    }
-    uint32_t idx[3];
-    idx[k] = uint32_t(slice);
-    for (int64_t j = rv[0]; j <= rv[1]; ++j) {
-      idx[other[1]] = uint32_t(j);
-      for (int64_t i = ru[0]; i <= ru[1]; ++i) {
-        idx[other[0]] = uint32_t(i);
-        ++st.cells;
-        const uint32_t c = accel.lookup(idx[0], idx[1], idx[2]);
-        if (c >= kSolidCell) continue;
-        for (uint32_t id : accel.cellPrims(c)) {
-          if (mailbox.seen(id)) {
-            st.mailboxSkips += lanes.count;
-            continue;
-          }
-          uint64_t hitBits = 0;
-          if (id < accel.triangleCount) {
-            const TriangleData& tri = accel.triangles[id];
-            if (outsidePacket(tri, k, other, c0, bounds)) continue;
-            st.tests += lanes.count;
-            hitBits = triangleLanes(tri, lanes);
-          } else {
-            st.tests += lanes.count;
-            for (uint32_t l = 0; l < lanes.count; ++l)
-              if (intersectPrimitive(accel, id, rays[lanes.ray[l]], lanes.t[l])) hitBits |= uint64_t(1) << l;
-          }
-          for (; hitBits != 0; hitBits &= hitBits - 1) {
-            const uint32_t l = uint32_t(__builtin_ctzll(hitBits));
-            Hit& h = best[lanes.ray[l]];
-            const double t = lanes.t[l];
-            if (closer(t, id, h)) {
-              h = {t, id};
-              // An occlusion query is answered by any hit: the lane retires after this slice.
-              const double limit = t + hitSlackAt(lanes.hitSlack[l], t);
-              lanes.stopAt[l] = any ? -kInfinity : std::min(lanes.tEnd[l], limit);
-            }
-          }
-        }
-      }
-    }
-    if (slice == last) break;
-    // Retire the rays that cannot meet anything nearer in the slices to come (the stop rule of traceRay: the best
-    // hit plus its slack lies before the next slice's boundary minus the exit slack), or whose walk ends before them.
-    const double boundary = forward ? bk[slice + 1] : bk[slice];
-    uint64_t retire = 0;
-    for (uint32_t l = 0; l < lanes.count; ++l) {
-      const double tCross = (boundary - lanes.ok[l]) * lanes.invK[l];
-      const double tNextMin = tCross - (lanes.tolK[l] + kWalkRel * std::fabs(tCross));
-      retire |= uint64_t(lanes.stopAt[l] < tNextMin) << l;
-    }
-    if (retire != 0) {
-      // Highest first: remove() moves the last lane into the freed one, and lanes above were already handled.
-      while (retire != 0) {
-        const uint32_t l = uint32_t(63 - __builtin_clzll(retire));
-        lanes.remove(l);
-        retire &= ~(uint64_t(1) << l);
-      }
-      boundsStale = true;
-    }
-  }
-  for (uint32_t r = 0; r < n; ++r) hits[r] = best[r];
-  if (stats) *stats += st;
+  for (uint32_t r = 0; r < rays.size(); ++r) hits[r] = p.best[r];
+  if (stats) *stats += p.st;
 }
 
 }  // namespace

@@ -332,168 +332,219 @@ VoxelizeStats gatherReferences(tbb::enumerable_thread_specific<Local>& locals, b
   return local;
 }
 
-// Voxelizes the primitives `ids` into the cells of `window` of the planned `grid`. A primitive's cell tests are the
-// same whatever the window (the filter's error bounds come from its whole cell range), so a brick gets exactly the
-// single grid's cells restricted to it, for every method.
-void voxelizeWindow(const Scene& scene, Grid& grid, const CellWindow& window, const PrimitiveList& ids,
-                    const VoxelizeOptions& options, VoxelizeStats* stats) {
-  const auto start = std::chrono::steady_clock::now();
-  const size_t nTri = scene.triangles.size();
-  const size_t nBounded = scene.boundedCount();
-  const size_t nWork = ids.size();
+// What the voxelization of every primitive of a window reads: the scene, the planned grid and its cell boundaries,
+// the window, the method, and how a reference is stored.
+struct WindowContext {
+  WindowContext(const Scene& scene_, const Grid& grid_, const CellWindow& window_, const VoxelizeOptions& options_)
+      : scene(scene_),
+        grid(grid_),
+        window(window_),
+        options(options_),
+        dims(grid_.dims),
+        nTri(scene_.triangles.size()),
+        primBits(std::max(1, int(std::bit_width(uint64_t(scene_.boundedCount() - 1))))),
+        keyBits(int(std::bit_width(grid_.cellCount() - 1))),
+        packed(primBits + keyBits <= 64) {
+    for (int a = 0; a < 3; ++a) {
+      boundary[a].resize(size_t(dims[a]) + 1);
+      for (int64_t i = 0; i <= int64_t(dims[a]); ++i) boundary[a][i] = cellBoundary(grid.bounds, dims, a, i);
+      boundaryScale[a] = double(dims[a]) / (grid.bounds.hi[a] - grid.bounds.lo[a]);
+    }
+  }
+  const Scene& scene;
+  const Grid& grid;
+  const CellWindow& window;
+  const VoxelizeOptions& options;
+  const std::array<uint32_t, 3> dims;
+  const size_t nTri;
+  const int primBits, keyBits;
+  const bool packed;                            // references as key << primBits | id (else pairs)
+  std::array<std::vector<double>, 3> boundary;  // cellBoundary(grid.bounds, dims, a, i) for i in [0, dims[a]]
+  std::array<double, 3> boundaryScale;          // cells per unit: a first guess of a cell index
 
+  Box cellBox(int64_t i, int64_t j, int64_t k) const {
+    return Box{{boundary[0][i], boundary[1][j], boundary[2][k]},
+               {boundary[0][i + 1], boundary[1][j + 1], boundary[2][k + 1]}};
+  }
+  void emit(Local& local, size_t id, int64_t i, int64_t j, int64_t k) const {
+    const uint64_t key = cellKey(dims, i, j, k);
+    if (packed)
+      local.packedRefs.push_back((key << primBits) | id);
+    else
+      local.pairRefs.emplace_back(key, uint32_t(id));
+  }
+};
+
+// Calls f(i, j, k) for every cell of `range`, x fastest.
+template <typename F>
+void forEachCell(const CellRange& range, F&& f) {
+  for (int64_t k = range.first[2]; k <= range.last[2]; ++k)
+    for (int64_t j = range.first[1]; j <= range.last[1]; ++j)
+      for (int64_t i = range.first[0]; i <= range.last[0]; ++i) f(i, j, k);
+}
+
+// OverlapMethod::Center, the course's quick test: the cell's centre inside the footprint (the triangle's bounding
+// box, or the sphere itself).
+void centerCells(const WindowContext& ctx, size_t id, const Box& primBox, const CellRange& range, Local& local) {
+  const bool isTri = id < ctx.nTri;
+  Mat4 toObject;
+  if (!isTri) toObject = inverse(ctx.scene.spheres[id - ctx.nTri].transform);
+  forEachCell(range, [&](int64_t i, int64_t j, int64_t k) {
+    const Box b = ctx.cellBox(i, j, k);
+    const Vec3 c = (b.lo + b.hi) * 0.5;
+    bool take;
+    if (isTri) {
+      take = c.x >= primBox.lo.x && c.x <= primBox.hi.x && c.y >= primBox.lo.y && c.y <= primBox.hi.y &&
+             c.z >= primBox.lo.z && c.z <= primBox.hi.z;
+    } else {
+      const Sphere& s = ctx.scene.spheres[id - ctx.nTri];
+      const Vec3 d = transformPoint(toObject, c) - s.center;
+      take = dot(d, d) <= s.radius * s.radius;
+    }
+    if (take) ctx.emit(local, id, i, j, k);
+  });
+}
+
+// A sphere's cells by the separating axes (sat) or the filtered exact test.
+void sphereCells(const WindowContext& ctx, size_t id, const CellRange& range, Local& local) {
+  const Sphere& s = ctx.scene.spheres[id - ctx.nTri];
+  forEachCell(range, [&](int64_t i, int64_t j, int64_t k) {
+    bool fallback = false;
+    const bool hit = ctx.options.method == OverlapMethod::Sat ? sphereBoxSat(s, ctx.cellBox(i, j, k))
+                                                              : sphereBoxFiltered(s, ctx.cellBox(i, j, k), &fallback);
+    local.fallbacks += fallback;
+    if (hit) ctx.emit(local, id, i, j, k);
+  });
+}
+
+// The triangle's filter, its error bounds from |corner - origin| over every cell of the triangle's whole cell range
+// (rounded up generously), not the window's part of it: the same bounds give the same undecided cells in every
+// brick.
+TriangleFilter preparedFilter(const WindowContext& ctx, const Triangle& t, const CellRange& fullRange) {
+  TriangleFilter filter(t);
+  double qMax[3];
+  for (int ax = 0; ax < 3; ++ax)
+    qMax[ax] = 1.0000001 * std::max(std::fabs(ctx.boundary[ax][fullRange.first[ax]] - filter.origin[ax]),
+                                    std::fabs(ctx.boundary[ax][fullRange.last[ax] + 1] - filter.origin[ax]));
+  filter.prepare(qMax);
+  return filter;
+}
+
+// The cells of one row of `range` along the sweep's axis a (idx[b], idx[c] given) that triangle `id` meets: the
+// sweep narrows the row to the cells its plane can reach, the filter decides each cell, and the undecided ones are
+// taken (sat) or asked of CGAL (exact).
+void triangleRow(const WindowContext& ctx, size_t id, const TriangleFilter& filter, const PlaneSweep& sweep,
+                 const CellRange& range, int64_t idx[3], Local& local) {
+  const int a = sweep.axis, b = (a + 1) % 3, c = (a + 2) % 3;
+  const auto& bnd = ctx.boundary;
+  int64_t from = range.first[a], to = range.last[a];
+  if (sweep.usable) {
+    const auto [lo, hi] = sweep.range(bnd[b][idx[b]], bnd[b][idx[b] + 1], bnd[c][idx[c]], bnd[c][idx[c] + 1]);
+    const auto& table = bnd[a];
+    const auto r = cellRangeOnAxis(
+        int64_t(ctx.dims[a]), ctx.boundaryScale[a], [&](int64_t i) { return table[size_t(i)]; }, lo, hi);
+    from = std::max(from, r[0]);
+    to = std::min(to, r[1]);
+  }
+  double lo[3], hi[3], rel[2][3];
+  for (int axis : {b, c}) {
+    lo[axis] = bnd[axis][idx[axis]];
+    hi[axis] = bnd[axis][idx[axis] + 1];
+    rel[0][axis] = lo[axis] - filter.origin[axis];
+    rel[1][axis] = hi[axis] - filter.origin[axis];
+  }
+  const bool sat = ctx.options.method == OverlapMethod::Sat;
+  for (idx[a] = from; idx[a] <= to; ++idx[a]) {
+    lo[a] = bnd[a][idx[a]];
+    hi[a] = bnd[a][idx[a] + 1];
+    rel[0][a] = lo[a] - filter.origin[a];
+    rel[1][a] = hi[a] - filter.origin[a];
+    const FilterResult r = filter.test(lo, hi, rel);
+    bool hit = r == FilterResult::Overlap;
+    if (r == FilterResult::Unknown) {
+      ++local.fallbacks;
+      hit = sat || triangleBoxExact(ctx.scene.triangles[id], Box{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}});
+    }
+    if (hit) ctx.emit(local, id, idx[0], idx[1], idx[2]);
+  }
+  local.tested += uint64_t(std::max<int64_t>(0, to - from + 1));
+}
+
+// A triangle's cells (sat or exact), row by row along the axis of its plane sweep.
+void triangleCells(const WindowContext& ctx, size_t id, const Box& primBox, const CellRange& range,
+                   const CellRange& fullRange, Local& local) {
+  const Triangle& t = ctx.scene.triangles[id];
+  const TriangleFilter filter = preparedFilter(ctx, t, fullRange);
+  if (isDegenerate(t)) ++local.degenerate;
+  const PlaneSweep sweep(filter, t, primBox);
+  const int b = (sweep.axis + 1) % 3, c = (sweep.axis + 2) % 3;
+  int64_t idx[3] = {0, 0, 0};
+  for (idx[c] = range.first[c]; idx[c] <= range.last[c]; ++idx[c])
+    for (idx[b] = range.first[b]; idx[b] <= range.last[b]; ++idx[b])
+      triangleRow(ctx, id, filter, sweep, range, idx, local);
+}
+
+// The references of bounded primitive `id` in the window's cells, by the method of the options.
+void voxelizePrimitive(const WindowContext& ctx, size_t id, Local& local) {
+  const bool isTri = id < ctx.nTri;
+  const Box primBox = isTri ? triangleBounds(ctx.scene.triangles[id]) : sphereBounds(ctx.scene.spheres[id - ctx.nTri]);
+  const auto fullRange = rangeOf(ctx.grid, primBox);
+  const auto range = clip(fullRange, ctx.window);
+  if (!range) return;
+  switch (ctx.options.method) {
+    case OverlapMethod::BBox:
+      forEachCell(*range, [&](int64_t i, int64_t j, int64_t k) { ctx.emit(local, id, i, j, k); });
+      local.tested += range->count();
+      return;
+    case OverlapMethod::Center:
+      centerCells(ctx, id, primBox, *range, local);
+      local.tested += range->count();
+      return;
+    case OverlapMethod::Sat:
+    case OverlapMethod::Exact:
+      if (isTri) {
+        triangleCells(ctx, id, primBox, *range, *fullRange, local);
+      } else {
+        sphereCells(ctx, id, *range, local);
+        local.tested += range->count();
+      }
+  }
+}
+
+// Fails with LimitError when the window's estimated references would take more memory than the options allow.
+void checkReferenceBudget(const Scene& scene, const Grid& grid, const CellWindow& window, const PrimitiveList& ids,
+                          const VoxelizeOptions& options) {
   const double estimate = estimateReferences(scene, grid, window, ids);
   constexpr double kBytesPerReference = 44;  // packed entry, radix buffer, and the compressed cell lists
   if (estimate * kBytesPerReference > double(options.memoryLimitBytes))
     fail<LimitError>("grid ", grid.dims[0], "x", grid.dims[1], "x", grid.dims[2], " needs about ",
                      uint64_t(estimate * kBytesPerReference / (1 << 20)), " MiB for ", uint64_t(estimate),
                      " cell references, more than the ", options.memoryLimitBytes >> 20, " MiB allowed");
+}
 
-  std::array<std::vector<double>, 3> boundary;
-  for (int a = 0; a < 3; ++a) {
-    boundary[a].resize(size_t(grid.dims[a]) + 1);
-    for (int64_t i = 0; i <= int64_t(grid.dims[a]); ++i) boundary[a][i] = cellBoundary(grid.bounds, grid.dims, a, i);
-  }
-
-  std::array<double, 3> boundaryScale;
-  for (int a = 0; a < 3; ++a) boundaryScale[a] = double(grid.dims[a]) / (grid.bounds.hi[a] - grid.bounds.lo[a]);
-
-  const int primBits = std::max(1, int(std::bit_width(uint64_t(nBounded - 1))));
-  const int keyBits = int(std::bit_width(grid.cellCount() - 1));
-  const bool packed = primBits + keyBits <= 64;
+// Voxelizes the primitives `ids` into the cells of `window` of the planned `grid`. A primitive's cell tests are the
+// same whatever the window (the filter's error bounds come from its whole cell range), so a brick gets exactly the
+// single grid's cells restricted to it, for every method.
+void voxelizeWindow(const Scene& scene, Grid& grid, const CellWindow& window, const PrimitiveList& ids,
+                    const VoxelizeOptions& options, VoxelizeStats* stats) {
+  const auto start = std::chrono::steady_clock::now();
+  const size_t nWork = ids.size();
+  checkReferenceBudget(scene, grid, window, ids, options);
+  const WindowContext ctx(scene, grid, window, options);
 
   tbb::enumerable_thread_specific<Local> locals;
   std::atomic<size_t> done{0};
   std::atomic<bool> cancelled{false};
-  const std::array<uint32_t, 3> dims = grid.dims;
-
-  auto voxelizePrimitive = [&](size_t id, Local& local) {
-    auto emit = [&](int64_t i, int64_t j, int64_t k) {
-      const uint64_t key = cellKey(dims, i, j, k);
-      if (packed) {
-        local.packedRefs.push_back((key << primBits) | id);
-      } else {
-        local.pairRefs.emplace_back(key, uint32_t(id));
-      }
-    };
-    const bool isTri = id < nTri;
-    const Box primBox = isTri ? triangleBounds(scene.triangles[id]) : sphereBounds(scene.spheres[id - nTri]);
-    const auto fullRange = rangeOf(grid, primBox);
-    const auto range = clip(fullRange, window);
-    if (!range) return;
-    const auto& [first, last] = *range;
-    if (options.method == OverlapMethod::BBox) {
-      for (int64_t k = first[2]; k <= last[2]; ++k)
-        for (int64_t j = first[1]; j <= last[1]; ++j)
-          for (int64_t i = first[0]; i <= last[0]; ++i) emit(i, j, k);
-      local.tested += range->count();
-      return;
-    }
-    auto box = [&](int64_t i, int64_t j, int64_t k) {
-      return Box{{boundary[0][i], boundary[1][j], boundary[2][k]},
-                 {boundary[0][i + 1], boundary[1][j + 1], boundary[2][k + 1]}};
-    };
-    if (options.method == OverlapMethod::Center) {
-      // The course's quick test: the cell's centre inside the footprint (bounding box, or the sphere itself).
-      Mat4 toObject;
-      if (!isTri) toObject = inverse(scene.spheres[id - nTri].transform);
-      for (int64_t k = first[2]; k <= last[2]; ++k)
-        for (int64_t j = first[1]; j <= last[1]; ++j)
-          for (int64_t i = first[0]; i <= last[0]; ++i) {
-            const Box b = box(i, j, k);
-            const Vec3 c = (b.lo + b.hi) * 0.5;
-            bool take;
-            if (isTri) {
-              take = c.x >= primBox.lo.x && c.x <= primBox.hi.x && c.y >= primBox.lo.y && c.y <= primBox.hi.y &&
-                     c.z >= primBox.lo.z && c.z <= primBox.hi.z;
-            } else {
-              const Sphere& s = scene.spheres[id - nTri];
-              const Vec3 d = transformPoint(toObject, c) - s.center;
-              take = dot(d, d) <= s.radius * s.radius;
-            }
-            if (take) emit(i, j, k);
-          }
-      local.tested += range->count();
-      return;
-    }
-    if (!isTri) {
-      const Sphere& s = scene.spheres[id - nTri];
-      for (int64_t k = first[2]; k <= last[2]; ++k)
-        for (int64_t j = first[1]; j <= last[1]; ++j)
-          for (int64_t i = first[0]; i <= last[0]; ++i) {
-            bool fallback = false;
-            const bool hit = options.method == OverlapMethod::Sat ? sphereBoxSat(s, box(i, j, k))
-                                                                  : sphereBoxFiltered(s, box(i, j, k), &fallback);
-            local.fallbacks += fallback;
-            if (hit) emit(i, j, k);
-          }
-      local.tested += range->count();
-      return;
-    }
-    const Triangle& t = scene.triangles[id];
-    TriangleFilter filter(t);
-    {
-      // |corner - origin| over every cell of the range, for the filter's error bounds (rounded up generously).
-      double qMax[3];
-      // Over the whole range, not the brick's part of it: the same bounds give the same undecided cells.
-      for (int ax = 0; ax < 3; ++ax)
-        qMax[ax] = 1.0000001 * std::max(std::fabs(boundary[ax][fullRange->first[ax]] - filter.origin[ax]),
-                                        std::fabs(boundary[ax][fullRange->last[ax] + 1] - filter.origin[ax]));
-      filter.prepare(qMax);
-    }
-    const bool sat = options.method == OverlapMethod::Sat;
-    if (isDegenerate(t)) ++local.degenerate;
-    const PlaneSweep sweep(filter, t, primBox);
-    const int a = sweep.axis, b = (a + 1) % 3, c = (a + 2) % 3;
-    int64_t idx[3];
-    for (idx[c] = first[c]; idx[c] <= last[c]; ++idx[c]) {
-      for (idx[b] = first[b]; idx[b] <= last[b]; ++idx[b]) {
-        int64_t from = first[a], to = last[a];
-        if (sweep.usable) {
-          const auto [lo, hi] =
-              sweep.range(boundary[b][idx[b]], boundary[b][idx[b] + 1], boundary[c][idx[c]], boundary[c][idx[c] + 1]);
-          const auto& table = boundary[a];
-          const auto r = cellRangeOnAxis(
-              int64_t(dims[a]), boundaryScale[a], [&](int64_t i) { return table[size_t(i)]; }, lo, hi);
-          from = std::max(from, r[0]);
-          to = std::min(to, r[1]);
-        }
-        double lo[3], hi[3], rel[2][3];
-        for (int axis : {b, c}) {
-          lo[axis] = boundary[axis][idx[axis]];
-          hi[axis] = boundary[axis][idx[axis] + 1];
-          rel[0][axis] = lo[axis] - filter.origin[axis];
-          rel[1][axis] = hi[axis] - filter.origin[axis];
-        }
-        for (idx[a] = from; idx[a] <= to; ++idx[a]) {
-          lo[a] = boundary[a][idx[a]];
-          hi[a] = boundary[a][idx[a] + 1];
-          rel[0][a] = lo[a] - filter.origin[a];
-          rel[1][a] = hi[a] - filter.origin[a];
-          const FilterResult r = filter.test(lo, hi, rel);
-          bool hit = r == FilterResult::Overlap;
-          if (r == FilterResult::Unknown) {
-            // sat takes undecided contacts; exact asks CGAL.
-            ++local.fallbacks;
-            hit = sat || triangleBoxExact(t, Box{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}});
-          }
-          if (hit) emit(idx[0], idx[1], idx[2]);
-        }
-        local.tested += uint64_t(std::max<int64_t>(0, to - from + 1));
-      }
-    }
-  };
-
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nWork, 256), [&](const tbb::blocked_range<size_t>& r) {
     if (cancelled.load(std::memory_order_relaxed)) return;
     Local& local = locals.local();
-    for (size_t n = r.begin(); n != r.end(); ++n) voxelizePrimitive(ids[n], local);
+    for (size_t n = r.begin(); n != r.end(); ++n) voxelizePrimitive(ctx, ids[n], local);
     const size_t finished = done.fetch_add(r.size()) + r.size();
     if (options.progress && !options.progress(0.9 * double(finished) / double(nWork))) cancelled = true;
   });
   if (cancelled) fail<Error>("voxelization cancelled");
 
-  VoxelizeStats local = gatherReferences(locals, packed, primBits, keyBits, grid);
+  VoxelizeStats local = gatherReferences(locals, ctx.packed, ctx.primBits, ctx.keyBits, grid);
   if (options.progress) options.progress(1.0);
   local.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (stats) *stats = local;

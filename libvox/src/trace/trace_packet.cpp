@@ -188,13 +188,13 @@ Hit alone(const Accel& accel, const Ray& ray, Query query, TraceStats* stats) {
 // (best[r] for ray r) and the counters. Lanes are not zeroed: 10 KB per packet would cost more than a packet's
 // slices; see Lanes::padTail().
 struct Packet {
-  Packet(const Accel& accel_, std::span<const Ray> rays_, int k_, Query query)
+  Packet(const Accel& accel_, std::span<const Ray> rays_, int k_, Query query_)
       : accel(accel_),
         cb(accel_.boundaries),
         rays(rays_),
         k(k_),
         other{(k_ + 1) % 3, (k_ + 2) % 3},
-        any(query == Query::Any),
+        query(query_),
         forward(rays_[0].direction[k_] > 0),
         c0(rays_[0].origin[k_]),
         bk(cb.b[k_].data()),
@@ -205,7 +205,8 @@ struct Packet {
   const CellBoundaries& cb;
   std::span<const Ray> rays;
   const int k, other[2];
-  const bool any, forward;
+  const Query query;
+  const bool forward;
   const double c0;  // slab coordinates are relative to the first ray's origin on k
   const double* const bk;
   const int64_t nk;
@@ -213,6 +214,8 @@ struct Packet {
   Hit best[kMaxPacketRays];
   Lanes lanes;
   AxisBounds bounds[2];
+
+  bool any() const { return query == Query::Any; }
 };
 
 // Tests ray r against the primitives every ray tests (planes, outside primitives) into p.best[r]; true when that
@@ -225,10 +228,10 @@ bool testAlwaysTested(Packet& p, uint32_t r) {
     ++p.st.tests;
     if (intersectPrimitive(p.accel, id, ray, t) && closer(t, id, p.best[r])) {
       p.best[r] = {t, id};
-      if (p.any) break;
+      if (p.any()) break;
     }
   }
-  return p.any && p.best[r].valid();
+  return p.any() && p.best[r].valid();
 }
 
 // What the lanes cover: the span of slab coordinates within [tMin, tEnd] and the largest origin coordinates.
@@ -316,7 +319,7 @@ void recordHits(Packet& p, uint32_t id, uint64_t hitBits) {
     if (closer(t, id, h)) {
       h = {t, id};
       const double limit = t + hitSlackAt(lanes.hitSlack[l], t);
-      lanes.stopAt[l] = p.any ? -kInfinity : std::min(lanes.tEnd[l], limit);
+      lanes.stopAt[l] = p.any() ? -kInfinity : std::min(lanes.tEnd[l], limit);
     }
   }
 }
@@ -430,9 +433,8 @@ void walkSlices(Packet& p, int64_t first, int64_t last) {
     // ray afresh, so its answer is the same whatever this packet found so far.
     if (ru[0] <= ru[1] && rv[0] <= rv[1] &&
         uint64_t(ru[1] - ru[0] + 1) * uint64_t(rv[1] - rv[0] + 1) > kMaxCellsPerLane * lanes.count + 8) {
-      const Query query = p.any ? Query::Any : Query::Nearest;
       for (uint32_t l = 0; l < lanes.count; ++l)
-        p.best[lanes.ray[l]] = alone(p.accel, p.rays[lanes.ray[l]], query, &p.st);
+        p.best[lanes.ray[l]] = alone(p.accel, p.rays[lanes.ray[l]], p.query, &p.st);
       p.st.rays -= lanes.count;
       break;
     }

@@ -1,0 +1,89 @@
+// Long calls: the GIL released, worker threads, Ctrl-C and progress (binding.h, Interrupt).
+#include <tbb/task_arena.h>
+
+#include "binding.h"
+#include "vox/core/error.h"
+
+namespace voxpy {
+
+Interrupt::Interrupt(py::object progress)
+    : caller_(std::this_thread::get_id()),
+      lastPoll_(std::chrono::steady_clock::now()),
+      progress_(std::move(progress)) {}
+
+Interrupt::~Interrupt() = default;
+
+bool Interrupt::poll(double fraction) {
+  if (cancelled()) return false;
+  // The largest fraction any thread reported: workers finish out of order.
+  double seen = fraction_.load(std::memory_order_relaxed);
+  while (fraction > seen && !fraction_.compare_exchange_weak(seen, fraction, std::memory_order_relaxed)) {
+  }
+  if (std::this_thread::get_id() != caller_) return true;
+  const auto now = std::chrono::steady_clock::now();
+  if (std::chrono::duration<double>(now - lastPoll_).count() < kPollSeconds && fraction < 1) return true;
+  lastPoll_ = now;
+  py::gil_scoped_acquire gil;
+  if (PyErr_CheckSignals() != 0) {
+    error_ = std::make_unique<py::error_already_set>();
+    cancelled_ = true;
+    return false;
+  }
+  const double done = fraction_.load(std::memory_order_relaxed);
+  if (!progress_.is_none() && done != reported_) {
+    reported_ = done;
+    try {
+      progress_(done);
+    } catch (py::error_already_set& e) {
+      error_ = std::make_unique<py::error_already_set>(std::move(e));
+      cancelled_ = true;
+      return false;
+    }
+  }
+  return true;
+}
+
+void Interrupt::finish() {
+  if (error_) {
+    auto error = std::move(error_);
+    throw py::error_already_set(std::move(*error));
+  }
+  if (!progress_.is_none() && reported_ < 1) {
+    reported_ = 1;
+    progress_(1.0);
+  }
+  // A signal that arrived after the last poll: Python runs its handler at the next bytecode anyway.
+}
+
+py::object progressCallable(const py::object& progress, const char* label) {
+  if (progress.is_none()) return py::none();
+  if (py::isinstance<py::bool_>(progress)) {
+    if (!progress.cast<bool>()) return py::none();
+    return py::module_::import("libvox._progress").attr("bar")(label);
+  }
+  if (!PyCallable_Check(progress.ptr()))
+    throw py::type_error("progress must be None, a bool or a callable taking the fraction done, not " +
+                         std::string(py::str(py::type::of(progress).attr("__name__"))));
+  return progress;
+}
+
+std::optional<int> threadsArg(const py::object& threads) {
+  if (threads.is_none()) return std::nullopt;
+  if (py::isinstance<py::bool_>(threads) || !py::isinstance<py::int_>(threads))
+    throw py::type_error("threads must be None or an int, not " +
+                         std::string(py::str(py::type::of(threads).attr("__name__"))));
+  const long long n = threads.cast<long long>();
+  if (n < 1 || n > 4096) vox::fail<vox::UsageError>("threads must be 1..4096 (None: all cores), got ", n);
+  return int(n);
+}
+
+void inArena(std::optional<int> threads, const std::function<void()>& body) {
+  if (!threads) {
+    body();
+    return;
+  }
+  tbb::task_arena arena(*threads);
+  arena.execute(body);
+}
+
+}  // namespace voxpy

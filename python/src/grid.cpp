@@ -1,0 +1,251 @@
+// libvox.Grid and libvox.load: a grid and its scene, read as numpy arrays (DESIGN.md "Python", "Grid").
+#include <sstream>
+
+#include "binding.h"
+#include "vox/core/error.h"
+#include "vox/export/voxel_runs.h"
+#include "vox/io/grid_set.h"
+#include "vox/io/input_file.h"
+
+namespace voxpy {
+
+PyGrid::PyGrid(vox::GridFile file, std::string source)
+    : file_(std::make_shared<const vox::GridFile>(std::move(file))), source_(std::move(source)) {}
+
+const vox::Accel& PyGrid::accel() {
+  std::call_once(accelOnce_, [&] {
+    accel_ = std::make_unique<vox::Accel>(vox::buildAccel(file_->scene, file_->grid, vox::AccelKind::Grid));
+  });
+  return *accel_;
+}
+
+namespace {
+
+using vox::Grid;
+
+double pitchOf(const Grid& g, int a) { return (g.bounds.hi[a] - g.bounds.lo[a]) / double(g.dims[a]); }
+
+// Checks that an array of `bytes` fits the memory budget before it is allocated (LimitError naming the grid).
+void checkArray(const PyGrid& grid, double bytes, const char* what) { vox::checkMemory(bytes, grid.source(), what); }
+
+py::array_t<int32_t> indicesOf(const Grid& g, std::span<const uint64_t> keys) {
+  py::array_t<int32_t> out({py::ssize_t(keys.size()), py::ssize_t(3)});
+  int32_t* p = out.mutable_data();
+  for (size_t c = 0; c < keys.size(); ++c) {
+    const auto ijk = vox::cellIndex(g.dims, keys[c]);
+    for (int a = 0; a < 3; ++a) p[3 * c + a] = int32_t(ijk[a]);
+  }
+  return out;
+}
+
+py::array_t<int32_t> solidIndices(PyGrid& self) {
+  const Grid& g = self.grid();
+  const uint64_t n = g.solidCount();
+  checkArray(self, double(n) * 12, "solid_indices");
+  py::array_t<int32_t> out({py::ssize_t(n), py::ssize_t(3)});
+  int32_t* p = out.mutable_data();
+  {
+    py::gil_scoped_release release;
+    for (const vox::CellRun& r : g.solidRuns)
+      for (uint64_t key = r.first; key < r.first + r.count; ++key, p += 3) {
+        const auto ijk = vox::cellIndex(g.dims, key);
+        p[0] = int32_t(ijk[0]), p[1] = int32_t(ijk[1]), p[2] = int32_t(ijk[2]);
+      }
+  }
+  return out;
+}
+
+py::array_t<bool> dense(PyGrid& self, bool solid) {
+  const Grid& g = self.grid();
+  checkArray(self, double(g.cellCount()), "dense()");
+  const auto [nx, ny, nz] = g.dims;
+  py::array_t<bool> out({py::ssize_t(nx), py::ssize_t(ny), py::ssize_t(nz)});
+  bool* p = out.mutable_data();
+  {
+    py::gil_scoped_release release;
+    std::fill(p, p + g.cellCount(), false);
+    // Index [i, j, k] of a C-ordered (nx, ny, nz) array; a voxel row runs along i.
+    const uint64_t strideI = uint64_t(ny) * nz;
+    auto mark = [&](const vox::VoxelRow& r) {
+      bool* q = p + uint64_t(r.i0) * strideI + uint64_t(r.j) * nz + r.k;
+      for (uint32_t n = 0; n < r.count; ++n) q[n * strideI] = true;
+    };
+    if (solid) {
+      vox::forEachVoxelRow(g, mark);
+    } else {
+      for (uint64_t key : g.cellKeys) {
+        const auto ijk = vox::cellIndex(g.dims, key);
+        p[uint64_t(ijk[0]) * strideI + uint64_t(ijk[1]) * nz + ijk[2]] = true;
+      }
+    }
+  }
+  return out;
+}
+
+py::array_t<double> points(const PyGrid& self) {
+  const Grid& g = self.grid();
+  py::array_t<double> out({py::ssize_t(g.occupiedCount()), py::ssize_t(3)});
+  double* p = out.mutable_data();
+  for (size_t c = 0; c < g.occupiedCount(); ++c) {
+    const auto ijk = vox::cellIndex(g.dims, g.cellKeys[c]);
+    for (int a = 0; a < 3; ++a)
+      p[3 * c + a] = 0.5 * (vox::cellBoundary(g.bounds, g.dims, a, ijk[a]) +
+                            vox::cellBoundary(g.bounds, g.dims, a, int64_t(ijk[a]) + 1));
+  }
+  return out;
+}
+
+py::array_t<int32_t> counts(const PyGrid& self) {
+  const Grid& g = self.grid();
+  py::array_t<int32_t> out(py::ssize_t(g.occupiedCount()));
+  int32_t* p = out.mutable_data();
+  for (size_t c = 0; c < g.occupiedCount(); ++c) p[c] = int32_t(g.cellStart[c + 1] - g.cellStart[c]);
+  return out;
+}
+
+py::array_t<bool> contains(PyGrid& self, const py::handle& query) {
+  const std::vector<vox::Vec3> q = vec3Array(query, "points", true);
+  py::array_t<bool> out(py::ssize_t(q.size()));
+  bool* p = out.mutable_data();
+  const Grid& g = self.grid();
+  py::gil_scoped_release release;
+  for (size_t n = 0; n < q.size(); ++n) {
+    // The closed cells holding the point: two on an axis where it lies on a boundary.
+    std::array<std::array<int64_t, 2>, 3> range;
+    bool inside = true;
+    for (int a = 0; a < 3; ++a) {
+      range[a] = vox::cellRange(g.bounds, g.dims, a, q[n][a], q[n][a]);
+      inside = inside && range[a][0] <= range[a][1];
+    }
+    bool hit = false;
+    for (int64_t k = range[2][0]; inside && !hit && k <= range[2][1]; ++k)
+      for (int64_t j = range[1][0]; !hit && j <= range[1][1]; ++j)
+        for (int64_t i = range[0][0]; !hit && i <= range[0][1]; ++i) {
+          const uint64_t key = vox::cellKey(g.dims, i, j, k);
+          hit = vox::findCell(g, key) >= 0 || vox::isSolid(g, key);
+        }
+    p[n] = hit;
+  }
+  return out;
+}
+
+std::string repr(const PyGrid& self) {
+  const Grid& g = self.grid();
+  std::ostringstream out;
+  out << "<libvox.Grid " << g.dims[0] << "x" << g.dims[1] << "x" << g.dims[2] << " " << vox::methodName(g.method)
+      << ", " << g.occupiedCount() << " occupied";
+  if (!g.solidRuns.empty()) out << ", " << g.solidCount() << " solid";
+  out << " cells, " << self.scene().primitiveCount() << " primitives>";
+  return out.str();
+}
+
+}  // namespace
+
+GridClass bindGrid(py::module_& m) {
+  GridClass grid(m, "Grid", R"doc(
+A sparse voxel grid and the scene it was voxelized from (read-only).
+
+Conventions: world coordinates are float64; cell indices are int32 [i, j, k] along x, y, z. Cell (i, j, k) is the
+closed box whose bounds on axis a are b_a(i) and b_a(i+1), b_a(i) = lo_a + (hi_a - lo_a) * i / n_a (double
+precision); its centre is the midpoint. A primitive touching a cell's face, edge or corner belongs to that cell.
+Occupied cells hold primitives; solid cells (voxelize(..., fill=True)) are empty cells inside closed surfaces.
+
+Made by libvox.voxelize, libvox.voxelize_batch(..., dense=False) and libvox.load; written by Grid.save.
+Arrays returned by properties are computed on each access unless noted (keep the result in a loop).
+)doc");
+  grid.def_property_readonly(
+          "dims", [](const PyGrid& s) { return py::make_tuple(s.grid().dims[0], s.grid().dims[1], s.grid().dims[2]); },
+          "Cells per axis (nx, ny, nz), a tuple of ints.")
+      .def_property_readonly(
+          "bounds",
+          [](const PyGrid& s) {
+            const vox::Box& b = s.grid().bounds;
+            py::array_t<double> out({2, 3});
+            double* p = out.mutable_data();
+            for (int a = 0; a < 3; ++a) p[a] = b.lo[a], p[3 + a] = b.hi[a];
+            return out;
+          },
+          "World bounds of the grid, (2, 3) float64: [[x0, y0, z0], [x1, y1, z1]].")
+      .def_property_readonly(
+          "pitch",
+          [](const PyGrid& s) {
+            py::array_t<double> out(3);
+            for (int a = 0; a < 3; ++a) out.mutable_data()[a] = pitchOf(s.grid(), a);
+            return out;
+          },
+          "Cell edge lengths (3,) float64: (hi - lo) / dims per axis.")
+      .def_property_readonly(
+          "transform",
+          [](const PyGrid& s) {
+            py::array_t<double> out({4, 4});
+            double* p = out.mutable_data();
+            std::fill(p, p + 16, 0.0);
+            for (int a = 0; a < 3; ++a) {
+              const double pitch = pitchOf(s.grid(), a);
+              p[4 * a + a] = pitch;
+              p[4 * a + 3] = s.grid().bounds.lo[a] + 0.5 * pitch;
+            }
+            p[15] = 1;
+            return out;
+          },
+          "(4, 4) float64 mapping [i, j, k, 1] to the cell centre [x, y, z, 1] (column vectors): diag(pitch), "
+          "translation lo + pitch / 2. Equal to `points` up to rounding; `points` are the exact midpoints.")
+      .def_property_readonly(
+          "method", [](const PyGrid& s) { return vox::methodName(s.grid().method); },
+          "Overlap method the grid was made with: 'exact', 'sat', 'bbox' or 'center'.")
+      .def_property_readonly(
+          "occupied_count", [](const PyGrid& s) { return s.grid().occupiedCount(); }, "Number of occupied cells N.")
+      .def_property_readonly(
+          "solid_count", [](const PyGrid& s) { return s.grid().solidCount(); },
+          "Number of solid cells M (0 without fill).")
+      .def_property_readonly(
+          "primitive_count", [](const PyGrid& s) { return s.scene().primitiveCount(); },
+          "Primitives of the scene: triangles, then spheres, then planes (their ids).")
+      .def_property_readonly(
+          "indices", [](const PyGrid& s) { return indicesOf(s.grid(), s.grid().cellKeys); },
+          "Occupied cells, (N, 3) int32 [i, j, k], in the file's order (ascending key i + nx (j + ny k)).")
+      .def_property_readonly("solid_indices", &solidIndices,
+                             "Solid cells (fill), (M, 3) int32 [i, j, k], ascending key. Empty without fill. "
+                             "LimitError when they would not fit in memory.")
+      .def("dense", &dense, py::arg("solid") = true, R"doc(
+The grid as a dense np.bool_ array of shape dims, indexed [i, j, k] (C order). True for occupied cells, and for
+solid cells too when `solid`. LimitError when nx*ny*nz bytes exceed the memory budget.
+)doc")
+      .def_property_readonly("points", &points, "Centres of the occupied cells, (N, 3) float64, in `indices` order.")
+      .def_property_readonly("counts", &counts, "Primitives held by each occupied cell, (N,) int32.")
+      .def_property_readonly(
+          "cell_primitives",
+          [](const py::object& self) {
+            const Grid& g = self.cast<PyGrid&>().grid();
+            static_assert(sizeof(uint64_t) == sizeof(int64_t));
+            return py::make_tuple(readOnlyView(reinterpret_cast<const int64_t*>(g.cellStart.data()),
+                                               {py::ssize_t(g.cellStart.size())}, self),
+                                  readOnlyView(g.primIds.data(), {py::ssize_t(g.primIds.size())}, self));
+          },
+          "(offsets, ids): the primitive ids of occupied cell c are ids[offsets[c]:offsets[c + 1]], ascending. "
+          "offsets (N + 1,) int64, ids (R,) uint32; read-only views of the grid's memory (no copy).")
+      .def("contains", &contains, py::arg("points"), R"doc(
+For each point of `points` ((P, 3) float), whether a closed cell holding it is occupied or solid: (P,) bool. A point
+on a boundary between cells counts for both; points outside the bounds are False.
+)doc")
+      .def_property_readonly("source", &PyGrid::source, "Where the grid came from: a file path, or '<arrays>'.")
+      .def("__repr__", &repr);
+
+  m.def(
+      "load",
+      [](const py::object& path) {
+        const auto p = pathArg(path);
+        if (!p) throw py::type_error("path must be a str or os.PathLike");
+        Interrupt interrupt;
+        vox::GridFile file = runLong(interrupt, std::nullopt, [&] { return vox::readGridOrSet(*p); });
+        return std::make_shared<PyGrid>(std::move(file), *p);
+      },
+      py::arg("path"), R"doc(
+Reads a grid file (.vgrid, vox-voxelize's output) or a grid set (vox-voxelize --bricks) with its scene. Every count,
+offset and the checksum are checked: InputError naming the file and the byte offset for a truncated, corrupt or
+newer-version file; LimitError when it cannot fit in memory.
+)doc");
+  return grid;
+}
+
+}  // namespace voxpy

@@ -1,0 +1,71 @@
+// Grid.mesh and Grid.colors: the voxel mesh and cell colours of vox-export as arrays.
+#include "binding.h"
+#include "vox/core/error.h"
+#include "vox/export/voxel_mesh.h"
+
+namespace voxpy {
+
+namespace {
+
+template <class Parse>
+auto optionArg(const char* name, const std::string& value, Parse&& parse) {
+  try {
+    return parse(value);
+  } catch (const vox::InputError& e) {
+    throw vox::UsageError(std::string(name) + ": " + e.what());
+  }
+}
+
+// (n, 4) uint8 RGBA (alpha 255) from 8-bit RGB display colours.
+py::array_t<uint8_t> rgba(const std::vector<vox::Rgb8>& colors) {
+  py::array_t<uint8_t> out({py::ssize_t(colors.size()), py::ssize_t(4)});
+  uint8_t* p = out.mutable_data();
+  for (size_t n = 0; n < colors.size(); ++n) {
+    p[4 * n] = colors[n][0], p[4 * n + 1] = colors[n][1], p[4 * n + 2] = colors[n][2];
+    p[4 * n + 3] = 255;
+  }
+  return out;
+}
+
+py::tuple mesh(PyGrid& self, const std::string& facesName, const std::string& colorName, const py::object& threads) {
+  const vox::FaceMode faces = optionArg("faces", facesName, vox::parseFaceMode);
+  const vox::ColorMode color = optionArg("color", colorName, vox::parseColorMode);
+  Interrupt interrupt;
+  vox::VoxelMesh m = runLong(interrupt, threadsArg(threads), [&] {
+    return vox::triangulateVoxelMesh(vox::buildVoxelMesh(self.grid(), self.scene(), faces, color));
+  });
+  if (m.vertexCount() > size_t(INT32_MAX)) vox::fail<vox::LimitError>("mesh(): more than 2^31 - 1 vertices");
+  const py::ssize_t nv = py::ssize_t(m.vertexCount()), nf = py::ssize_t(m.faceCount());
+  py::object colors = m.hasColors() ? py::object(rgba(m.faceColors)) : py::object(py::none());
+  static_assert(sizeof(vox::Vec3) == 3 * sizeof(double));
+  return py::make_tuple(adoptVector<double>(std::move(m.positions), {nv, 3}),
+                        adoptVector<int32_t>(std::move(m.faceVertices), {nf, 3}), colors);
+}
+
+py::array_t<uint8_t> colors(PyGrid& self, const std::string& modeName) {
+  const vox::ColorMode mode = optionArg("mode", modeName, vox::parseColorMode);
+  if (mode == vox::ColorMode::None) vox::fail<vox::UsageError>("mode: expected 'count' or 'material'");
+  Interrupt interrupt;
+  const auto c =
+      runLong(interrupt, std::nullopt, [&] { return vox::occupiedCellColors(self.grid(), self.scene(), mode); });
+  return rgba(c);
+}
+
+}  // namespace
+
+void bindMesh(GridClass& grid) {
+  grid.def("mesh", &mesh, py::kw_only(), py::arg("faces") = "merged", py::arg("color") = "none",
+           py::arg("threads") = py::none(), R"doc(
+The voxels (occupied and solid cells) as a triangle mesh, as vox-export builds it: vertices (V, 3) float64 on the
+cell lattice (world space), faces (F, 3) int32, counter-clockwise seen from outside, and face_colors (F, 4) uint8
+RGBA (sRGB) or None when color='none'. faces: 'all' (12 triangles per voxel), 'exposed' (closed, 2-manifold) or
+'merged' (exposed faces merged into rectangles, no T-junctions); color: 'count', 'material' or 'none'.
+)doc");
+  grid.def("colors", &colors, py::arg("mode") = "material", R"doc(
+The display colour of each occupied cell ((N, 4) uint8 RGBA, sRGB, alpha 255, `indices` order), as vox-export paints
+it: 'material' (the material held by most of the cell's primitives, textures averaged over the cell) or 'count'
+(primitives per cell on the viridis ramp, log scale).
+)doc");
+}
+
+}  // namespace voxpy

@@ -1,0 +1,295 @@
+// libvox.voxelize and libvox.voxelize_batch: a scene file or arrays in, a Grid or dense arrays out, as vox-voxelize
+// makes them (the same library calls in the same order: loadScene, voxelizeScene, fillSolid).
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+
+#include "binding.h"
+#include "vox/core/error.h"
+#include "vox/export/voxel_runs.h"
+#include "vox/import/import.h"
+#include "vox/io/input_file.h"
+#include "vox/voxelize/fill.h"
+#include "vox/voxelize/voxelize.h"
+
+namespace voxpy {
+
+namespace {
+
+// A voxelize source: a scene file to read (with the GIL released), or a scene made from arrays.
+struct Source {
+  std::optional<std::string> path;
+  vox::Scene scene;
+  std::string name;  // the path, or "<arrays>"
+
+  const vox::Scene& load() {
+    if (path) {
+      scene = vox::loadScene(*path);
+      path.reset();
+    }
+    return scene;
+  }
+};
+
+Source sourceArg(const py::handle& obj, const std::string& what) {
+  Source s;
+  if (auto p = pathArg(obj)) {
+    s.path = *p;
+    s.name = *p;
+    return s;
+  }
+  s.name = "<arrays>";
+  if ((py::isinstance<py::tuple>(obj) || py::isinstance<py::list>(obj)) && py::len(obj) == 2) {
+    const py::sequence pair = py::reinterpret_borrow<py::sequence>(obj);
+    s.scene = sceneFromArrays(pair[0], pair[1]);
+  } else if (py::hasattr(obj, "vertices") && py::hasattr(obj, "faces")) {
+    s.scene = sceneFromArrays(obj.attr("vertices"), obj.attr("faces"));
+  } else {
+    throw py::type_error(what +
+                         " must be a path, a (vertices, faces) pair or an object with .vertices and .faces, not " +
+                         std::string(py::str(py::type::of(obj).attr("__name__"))));
+  }
+  return s;
+}
+
+vox::OverlapMethod methodArg(const std::string& name) {
+  try {
+    return vox::parseMethod(name);
+  } catch (const vox::InputError& e) {
+    throw vox::UsageError(std::string("method: ") + e.what());
+  }
+}
+
+uint32_t resolutionArg(const py::object& obj, const char* name) {
+  if (py::isinstance<py::bool_>(obj) || !py::isinstance<py::int_>(obj))
+    throw py::type_error(std::string(name) + " must be an int, not " +
+                         std::string(py::str(py::type::of(obj).attr("__name__"))));
+  const long long n = obj.cast<long long>();
+  if (n < 1 || n > vox::kMaxCellsPerAxis)
+    vox::fail<vox::UsageError>(name, " must be 1..", vox::kMaxCellsPerAxis, ", got ", n);
+  return uint32_t(n);
+}
+
+bool fillArg(const py::object& fill) {
+  if (fill.is_none()) return false;
+  if (!py::isinstance<py::bool_>(fill)) throw py::type_error("fill must be None or a bool");
+  return fill.cast<bool>();
+}
+
+// pitch: cells of that edge length (per axis when three numbers): dims = ceil(extent / pitch), the bounds grown
+// symmetrically to whole cells (DESIGN.md "Python").
+struct Pitch {
+  vox::Vec3 size;
+};
+
+void applyPitch(const Pitch& pitch, const vox::Scene& scene, vox::VoxelizeOptions& vo) {
+  std::optional<vox::Box> extent = vo.bounds;
+  if (!extent) extent = vox::sceneBounds(scene);
+  if (!extent) return;  // no bounded primitive: planGrid's empty 1x1x1 grid
+  vox::Box b = *extent;
+  std::array<uint32_t, 3> dims{};
+  for (int a = 0; a < 3; ++a) {
+    const double p = pitch.size[a], lo = b.lo[a], hi = b.hi[a];
+    const double cells = std::ceil((hi - lo) / p);
+    if (!(cells <= vox::kMaxCellsPerAxis))
+      vox::fail<vox::UsageError>("pitch ", p, " gives ", cells, " cells on axis ", "xyz"[a], ", more than ",
+                                 vox::kMaxCellsPerAxis);
+    dims[a] = std::max<uint32_t>(1, uint32_t(cells));
+    const double mid = 0.5 * (lo + hi), half = 0.5 * dims[a] * p;
+    b.lo.at(a) = std::min(lo, mid - half);  // min/max: never cut the extent by a rounding
+    b.hi.at(a) = std::max(hi, mid + half);
+  }
+  vo.bounds = b;
+  vo.dims = dims;
+}
+
+void warn(const std::string& message) {
+  if (PyErr_WarnEx(PyExc_UserWarning, message.c_str(), 1) != 0) throw py::error_already_set();
+}
+
+// The library's LimitError and InputError of a voxelization named with the scene, as vox-voxelize names them.
+template <class Work>
+auto namedAfter(const std::string& name, Work&& work) -> decltype(work()) {
+  try {
+    return work();
+  } catch (const vox::LimitError& e) {
+    vox::fail<vox::LimitError>(name, ": ", e.what());
+  } catch (const vox::InputError& e) {
+    if (std::string(e.what()).rfind(name, 0) == 0) throw;  // the importers name the file already
+    vox::fail<vox::InputError>(name, ": ", e.what());
+  }
+}
+
+std::shared_ptr<PyGrid> voxelize(const py::object& source, const py::object& resolution, const py::object& dims,
+                                 const py::object& pitch, const py::object& bounds, const std::string& method,
+                                 const py::object& fill, const py::object& threads, const py::object& progress) {
+  Source src = sourceArg(source, "source");
+  vox::VoxelizeOptions vo;
+  vo.method = methodArg(method);
+  const int given = int(!resolution.is_none()) + int(!dims.is_none()) + int(!pitch.is_none());
+  if (given > 1) vox::fail<vox::UsageError>("give at most one of resolution, dims and pitch");
+  if (!resolution.is_none()) vo.resolution = resolutionArg(resolution, "resolution");
+  if (!dims.is_none()) vo.dims = dims3Arg(dims, "dims");
+  if (!bounds.is_none()) vo.bounds = boxArg(bounds, "bounds");
+  std::optional<Pitch> pitchSize;
+  if (!pitch.is_none()) {
+    const py::array p = py::array::ensure(pitch);
+    const vox::Vec3 size = p && p.ndim() == 0 ? vox::Vec3{1, 1, 1} * pitch.cast<double>() : vec3Arg(pitch, "pitch");
+    if (!(size.x > 0 && size.y > 0 && size.z > 0 && vox::isFinite(size)))
+      vox::fail<vox::UsageError>("pitch must be positive and finite");
+    pitchSize = Pitch{size};
+  }
+  const bool doFill = fillArg(fill);
+  const auto nThreads = threadsArg(threads);
+  vo.memoryLimitBytes = vox::memoryBudgetBytes();
+  Interrupt interrupt(progressCallable(progress, "voxelizing"));
+  vo.progress = [&](double f) { return interrupt.poll(doFill ? 0.7 * f : f); };
+  vox::FillReport report;
+  vox::Grid grid = runLong(interrupt, nThreads, [&] {
+    const vox::Scene& scene = src.load();
+    if (pitchSize) applyPitch(*pitchSize, scene, vo);
+    return namedAfter(src.name, [&] {
+      vox::Grid g = vox::voxelizeScene(scene, vo);
+      if (doFill) {
+        vox::FillOptions fo;
+        fo.memoryLimitBytes = vo.memoryLimitBytes;
+        fo.progress = [&](double f) { return interrupt.poll(0.7 + 0.3 * f); };
+        report = vox::fillSolid(g, scene, fo);
+      }
+      return g;
+    });
+  });
+  for (const std::string& w : src.scene.warnings) warn(src.name + ": " + w);
+  if (doFill)
+    if (const std::string w = vox::fillWarning(report); !w.empty()) warn(src.name + ": fill: " + w);
+  return std::make_shared<PyGrid>(vox::GridFile{std::move(src.scene), std::move(grid)}, src.name);
+}
+
+// The cube of `resolution` cells a side that voxelize_batch gives a mesh: its longest axis exactly, the others
+// centred on the mesh; a mesh of one point gets the unit cube around it (planGrid pads it the same way).
+vox::Box batchCube(const vox::Box& b) {
+  const vox::Vec3 extent = b.hi - b.lo;
+  int longest = 0;
+  for (int a = 1; a < 3; ++a)
+    if (extent[a] > extent[longest]) longest = a;
+  const double side = extent[longest] > 0 ? extent[longest] : 1.0;
+  vox::Box cube;
+  for (int a = 0; a < 3; ++a) {
+    if (a == longest && extent[a] > 0) {
+      cube.lo.at(a) = b.lo[a];
+      cube.hi.at(a) = b.hi[a];
+    } else {
+      const double mid = 0.5 * (b.lo[a] + b.hi[a]);
+      cube.lo.at(a) = std::min(b.lo[a], mid - 0.5 * side);
+      cube.hi.at(a) = std::max(b.hi[a], mid + 0.5 * side);
+    }
+  }
+  return cube;
+}
+
+py::object voxelizeBatch(const py::iterable& sources, const py::object& resolution, const py::object& fill,
+                         const std::string& method, const py::object& threads, bool dense, const py::object& progress) {
+  std::vector<Source> srcs;
+  size_t index = 0;
+  for (const py::handle s : sources) {
+    srcs.push_back(sourceArg(s, "sources[" + std::to_string(index) + "]"));
+    ++index;
+  }
+  const uint32_t r = resolutionArg(resolution, "resolution");
+  const vox::OverlapMethod m = methodArg(method);
+  const bool doFill = fillArg(fill);
+  const auto nThreads = threadsArg(threads);
+  const uint64_t budget = vox::memoryBudgetBytes();
+  const uint64_t cube = uint64_t(r) * r * r;
+  py::array_t<bool> out;
+  bool* cells = nullptr;
+  if (dense) {
+    vox::checkMemory(double(cube) * double(srcs.size()), "voxelize_batch", "the dense array");
+    out = py::array_t<bool>({py::ssize_t(srcs.size()), py::ssize_t(r), py::ssize_t(r), py::ssize_t(r)});
+    cells = out.mutable_data();
+  }
+  std::vector<vox::Grid> grids(dense ? 0 : srcs.size());
+  Interrupt interrupt(progressCallable(progress, "voxelizing"));
+  std::atomic<size_t> done{0};
+  runLong(interrupt, nThreads, [&] {
+    if (cells) std::fill(cells, cells + cube * srcs.size(), false);
+    tbb::parallel_for(size_t(0), srcs.size(), [&](size_t b) {
+      if (interrupt.cancelled()) return;
+      Source& src = srcs[b];
+      const std::string name = "sources[" + std::to_string(b) + "] (" + src.name + ")";
+      vox::Grid g = namedAfter(name, [&] {
+        const vox::Scene& scene = src.load();
+        vox::VoxelizeOptions vo;
+        vo.method = m;
+        vo.memoryLimitBytes = budget;
+        vo.dims = std::array<uint32_t, 3>{r, r, r};
+        if (const auto bounds = vox::sceneBounds(scene)) vo.bounds = batchCube(*bounds);
+        vo.progress = [&](double) { return interrupt.poll(double(done.load()) / double(srcs.size())); };
+        vox::Grid g = vox::voxelizeScene(scene, vo);
+        if (doFill) {
+          vox::FillOptions fo;
+          fo.memoryLimitBytes = budget;
+          fo.progress = vo.progress;
+          vox::fillSolid(g, scene, fo);
+        }
+        return g;
+      });
+      if (cells) {
+        bool* p = cells + cube * b;
+        vox::forEachVoxelRow(g, [&](const vox::VoxelRow& row) {
+          for (uint32_t n = 0; n < row.count; ++n) p[(uint64_t(row.i0 + n) * r + row.j) * r + row.k] = true;
+        });
+      } else {
+        grids[b] = std::move(g);
+      }
+      interrupt.poll(double(done.fetch_add(1) + 1) / double(srcs.size()));
+    });
+    if (interrupt.cancelled()) vox::fail<vox::Error>("voxelize_batch cancelled");
+  });
+  if (dense) return out;
+  py::list list;
+  for (size_t b = 0; b < srcs.size(); ++b)
+    list.append(std::make_shared<PyGrid>(vox::GridFile{std::move(srcs[b].scene), std::move(grids[b])}, srcs[b].name));
+  return list;
+}
+
+}  // namespace
+
+void bindVoxelize(py::module_& m) {
+  m.def("voxelize", &voxelize, py::arg("source"), py::kw_only(), py::arg("resolution") = py::none(),
+        py::arg("dims") = py::none(), py::arg("pitch") = py::none(), py::arg("bounds") = py::none(),
+        py::arg("method") = "exact", py::arg("fill") = py::none(), py::arg("threads") = py::none(),
+        py::arg("progress") = false, R"doc(
+Puts every triangle and sphere of a scene into the closed cells it meets, as `vox-voxelize` does (the same cells and
+primitive ids).
+
+source: a path (.obj, .ply, .gltf, .glb, or the course's .txt scenes), a (vertices, faces) pair of arrays
+    (vertices (V, 3) float32 or float64, widened exactly; faces (F, 3) integers; triangle i is face i), or any
+    object with .vertices and .faces (a trimesh.Trimesh).
+resolution: cells on the longest axis, cells as cubic as possible (vox-voxelize --res).
+dims: (nx, ny, nz) cells (--grid); one int for all three.
+pitch: cell edge length (one number, or three): dims = ceil(extent / pitch), bounds grown symmetrically to whole
+    cells. At most one of resolution, dims, pitch; with none, about 3 cells per primitive.
+bounds: ((x0, y0, z0), (x1, y1, z1)); default: the bounds of the primitives. Primitives sticking out are kept and
+    traced separately.
+method: 'exact' (CGAL exact predicates, default), 'sat', 'bbox' or 'center'.
+fill: True also marks the empty cells inside closed surfaces as solid (generalized winding number for open meshes).
+threads: worker threads (default: all cores).
+progress: True for a tqdm bar (when tqdm is installed), or a callable taking the fraction done.
+
+The GIL is released while it works; Ctrl-C raises KeyboardInterrupt within a fraction of a second.
+Raises InputError (bad file, with the file and place; bad arrays), UsageError (bad options), LimitError (the grid
+would not fit in memory, checked before allocating), TypeError (wrong argument types).
+)doc");
+
+  m.def("voxelize_batch", &voxelizeBatch, py::arg("sources"), py::arg("resolution") = 64, py::kw_only(),
+        py::arg("fill") = py::none(), py::arg("method") = "exact", py::arg("threads") = py::none(),
+        py::arg("dense") = true, py::arg("progress") = false, R"doc(
+Voxelizes many meshes, spread over worker threads: each source (as for voxelize) in its own cubic grid of
+`resolution` cells per axis over its own bounds (cubic cells: the longest axis spans the mesh exactly, the others
+are centred on it). Returns np.bool_ of shape (B, R, R, R) indexed [b, i, j, k] (occupied and solid cells), or a
+list of Grids when dense=False. Errors name the source's index.
+)doc");
+}
+
+}  // namespace voxpy

@@ -32,11 +32,17 @@ class BuildWithCMake(build_py):
     def run(self):
         super().run()
         build = pathlib.Path(os.environ.get("LIBVOX_BUILD_DIR", ROOT / "build-python")).resolve()
-        configure = ["cmake", "-S", str(ROOT), "-B", str(build), "-G", "Ninja", "-DVOX_PYTHON=ON",
-                     f"-DPython3_EXECUTABLE={sys.executable}"]
-        if not (build / "CMakeCache.txt").exists():
-            # A fresh folder builds what the package needs: no tests (they need the seed scenes).
-            configure += ["-DCMAKE_BUILD_TYPE=Release", "-DVOX_TESTS=OFF"]
+        configure = ["cmake", "-S", str(ROOT), "-B", str(build), "-G", "Ninja", "-DVOX_PYTHON=ON"]
+        cache = build / "CMakeCache.txt"
+        python = os.path.realpath(sys.executable)  # a venv's python is a link to the system's
+        if not cache.exists():
+            # A fresh folder builds what the package needs, for this Python: no tests (they need the seed scenes).
+            configure += ["-DCMAKE_BUILD_TYPE=Release", "-DVOX_TESTS=OFF", f"-DPython3_EXECUTABLE={python}"]
+        else:
+            for line in cache.read_text().splitlines():
+                if line.startswith("Python3_EXECUTABLE:") and os.path.realpath(line.split("=", 1)[1]) != python:
+                    sys.exit(f"setup.py: {build} builds for {line.split('=', 1)[1]}, not {python}: "
+                             "set LIBVOX_BUILD_DIR to another folder")
         subprocess.run(configure, check=True, stdout=subprocess.DEVNULL)
         ninja = ["cmake", "--build", str(build), "--target", "_libvox"]
         if os.environ.get("LIBVOX_JOBS"):

@@ -6,10 +6,13 @@ packages=(build-essential cmake ninja-build pkg-config python3
   libcgal-dev libopenmesh-dev libopenimageio-dev libtinygltf-dev libstb-dev nlohmann-json3-dev
   libtbb-dev libcli11-dev libgtest-dev
   openmpi-bin libopenmpi-dev
-  libopenvdb-dev)  # vox-export writes .vdb (export/vdb_writer.cpp)
+  libopenvdb-dev  # vox-export writes .vdb (export/vdb_writer.cpp)
+  # The Python package (python/, docs/python.md) and its tests.
+  python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-setuptools python3-venv python3-pip)
 for arg in "$@"; do
   case $arg in
-    --bench) packages+=(libbenchmark-dev libembree-dev) ;;
+    # bench/python_bench.py compares with Open3D (Debian's 0.16) and draws its bars with tqdm.
+    --bench) packages+=(libbenchmark-dev libembree-dev python3-open3d python3-tqdm) ;;
     --meshlab) packages+=(meshlab xvfb xauth) ;;
     # Real clients of exported meshes (tests/cli/export_*.sh); numpy for Blender's glTF importer.
     # python3-openvdb (pyopenvdb) reads exported .vdb files back (tests/cli/export_voxel_formats.sh).

@@ -338,20 +338,24 @@ Image traceImage(const Scene& scene, const Accel& accel, const RenderOptions& op
   if (options.filter != FilterKind::None)
     store = makeSampleStore(image.width, image.height, options.samples, image.channels);
   tbb::combinable<TraceStats> perThread;
-  std::atomic<uint64_t> rowsDone{0};
+  std::atomic<uint64_t> pixelsDone{0};
+  const double pixels = double(image.width) * double(image.height);
   const auto start = std::chrono::steady_clock::now();
   constexpr uint32_t kTile = 16;
   tbb::parallel_for(tbb::blocked_range2d<uint32_t>(0, image.height, kTile, 0, image.width, kTile),
                     [&](const tbb::blocked_range2d<uint32_t>& tile) {
                       TraceStats& st = perThread.local();
                       const auto rows = tile.rows(), cols = tile.cols();
-                      for (uint32_t by = rows.begin(); by < rows.end(); by += Renderer::kBlock)
+                      for (uint32_t by = rows.begin(); by < rows.end(); by += Renderer::kBlock) {
+                        const uint32_t byEnd = std::min(by + Renderer::kBlock, rows.end());
                         for (uint32_t bx = cols.begin(); bx < cols.end(); bx += Renderer::kBlock)
-                          r.renderBlock(bx, std::min(bx + Renderer::kBlock, cols.end()), by,
-                                        std::min(by + Renderer::kBlock, rows.end()), image, store, st);
-                      if (options.progress && cols.end() == image.width) {
-                        const uint64_t done = rowsDone.fetch_add(rows.size()) + rows.size();
-                        options.progress(double(done) / image.height);
+                          r.renderBlock(bx, std::min(bx + Renderer::kBlock, cols.end()), by, byEnd, image, store, st);
+                        // After every row of blocks, not every band of the image's rows: a caller that cancels by
+                        // throwing from progress (the Python module on Ctrl-C) waits for a few blocks (issue 24).
+                        if (options.progress) {
+                          const uint64_t done = uint64_t(byEnd - by) * cols.size();
+                          options.progress(double(pixelsDone.fetch_add(done) + done) / pixels);
+                        }
                       }
                     });
   if (store.active()) image = filterSamples(store, options.filter, options.filterRadius);

@@ -50,7 +50,8 @@ struct RenderOptions {
   double filterRadius = 0.5;             // pixels
   Camera camera;                         // already resolved (scene camera, overrides or defaultCamera)
   uint64_t seed = 0;                     // of the per-pixel jitter
-  // Called from worker threads with the fraction of rows done; may be empty.
+  // Called from worker threads after each row of blocks of a tile with the fraction of pixels done; may be empty.
+  // May throw to cancel (the exception leaves traceImage).
   std::function<void(double)> progress;
 };
 

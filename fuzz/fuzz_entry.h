@@ -12,6 +12,7 @@
 #include <fstream>
 #include <iterator>
 #include <optional>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -200,6 +201,27 @@ inline void compareSetVoxelFiles(const GridFile& file, const std::string& setPat
   }
 }
 
+// A rerun over this set removes the files its manifest lists (removeGridSetFiles): a crafted manifest must never
+// make it remove anything but files of the set layout inside the set's folder. Files the manifest may name, outside
+// that layout or outside the folder, are planted first and must survive.
+inline void removeReplacedSet(const std::filesystem::path& area, const std::filesystem::path& folder,
+                              const std::string& path, const GridSetManifest& m) {
+  static const std::regex layout(R"(^fuzz\.bricks/(g[0-9a-f]{16}/)?(scene|b_[0-9]+_[0-9]+_[0-9]+)\.vgrid$)");
+  std::vector<std::filesystem::path> planted{area / "keep.vgrid", folder / "keep.vgrid"};
+  std::vector<std::string> names{m.scene.file};
+  for (const BrickEntry& e : m.entries) names.push_back(e.file);
+  for (const std::string& name : names)
+    if (const auto p = partPath(area, folder, name); p && !std::regex_match(name, layout)) planted.push_back(*p);
+  for (const auto& p : planted)
+    if (!std::filesystem::exists(p)) writePart(p, "user data");
+  removeGridSetFiles(path, m);
+  for (const auto& p : planted)
+    if (!std::filesystem::exists(p)) {
+      std::fprintf(stderr, "removing a replaced set removed %s, not a file of its layout\n", p.c_str());
+      std::abort();
+    }
+}
+
 // Reads a grid set made of `bytes` (parts split by kSetPartMarker): headers fixed, then, when the manifest decodes,
 // its listed sizes and checksums set to the parts given (so the bricks' contents are reached), each part written
 // where the manifest names it inside the private folder, and the set read whole (readGridOrSet, as vox-trace and
@@ -271,6 +293,7 @@ inline void readGridSetBytes(std::string_view input) {
                  lazyRead ? "read" : "refused", whole == lazy ? "equal" : "differ");
     std::abort();
   }
+  removeReplacedSet(area, folder, path, m);
 }
 
 // The grid target's input: a grid set (parts starting with the manifest's magic) or a grid file.

@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <memory>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -98,7 +100,7 @@ TEST(GridSet, ManifestsThatLieAreRefused) {
   m.entries[0].file = "../" + m.entries[0].file;
   refused(m, "outside");
   m = good;
-  m.entries[0].file = m.entries[0].file + "/../../../" + m.entries[0].file;  // out through the brick folder
+  m.entries[0].file = m.entries[0].file + "/../../../../" + m.entries[0].file;  // out through the brick folders
   refused(m, "outside");
   m = good;
   m.scene.file = "../" + m.scene.file;
@@ -156,14 +158,159 @@ TEST(GridSet, NamesWithControlBytesAreNotWritten) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("a\nb.bricks")));
 }
 
+// The files under the brick folders of a scratch folder, as "NAME.bricks/gHEX/FILE" (temporary files included).
+std::vector<std::string> setFiles(const testing::ScratchDir& dir) {
+  std::vector<std::string> files;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(dir.path()))
+    if (!e.is_directory()) files.push_back(std::filesystem::relative(e.path(), dir.path()).string());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+VoxelizeOptions optionsCancellingAfter(int calls) {
+  VoxelizeOptions o;
+  o.dims = std::array<uint32_t, 3>{12, 10, 8};
+  auto left = std::make_shared<int>(calls);
+  o.progress = [left](double) { return --*left > 0; };
+  return o;
+}
+
 TEST(GridSet, NoManifestWhenABrickCannotBeWritten) {
   testing::ScratchDir dir("gridset_fail");
   const std::string path = dir.file("s.vgrid");
+  EXPECT_THROW(writeGridSet(path, sceneWithPlane(5), optionsCancellingAfter(3), {3, 2, 2}), Error);
+  EXPECT_FALSE(std::filesystem::exists(path));
+  EXPECT_EQ(setFiles(dir), std::vector<std::string>{});  // the new generation folder went with the failure
+}
+
+// Issue 23: a rerun that fails after writing bricks (here: cancelled at the third brick) leaves the old set whole
+// and readable, and no file of its own; a rerun that succeeds replaces the set and removes the old set's files.
+TEST(GridSet, AFailedRerunLeavesTheOldSetWholeAndASuccessfulOneReplacesIt) {
+  testing::ScratchDir dir("gridset_rerun");
+  const std::string path = dir.file("s.vgrid");
   VoxelizeOptions o;
   o.dims = std::array<uint32_t, 3>{6, 5, 4};
-  std::filesystem::create_directories(dir.file("s.bricks/b_1_0_0.vgrid"));  // a folder where a brick goes
-  EXPECT_THROW(writeGridSet(path, sceneWithPlane(5), o, {2, 1, 1}), OutputError);
-  EXPECT_FALSE(std::filesystem::exists(path));
+  const Scene first = sceneWithPlane(3), second = sceneWithPlane(4);
+  writeGridSet(path, first, o, {3, 2, 2});
+  const std::vector<std::string> before = setFiles(dir);
+  const Grid old = readGridSet(path).grid;
+  EXPECT_THROW(writeGridSet(path, second, optionsCancellingAfter(3), {3, 2, 2}), Error);
+  EXPECT_EQ(setFiles(dir), before);
+  expectSameGrid(readGridSet(path).grid, old);
+
+  writeGridSet(path, second, o, {2, 1, 1});
+  expectSameGrid(readGridSet(path).grid, voxelizeScene(second, o));
+  for (const std::string& f : setFiles(dir))
+    EXPECT_TRUE(std::find(before.begin(), before.end(), f) == before.end() || f == "s.vgrid") << f << " left over";
+  // Exactly the new set's files: the manifest, the scene file and its bricks, in one generation folder.
+  const GridSetManifest m = readGridSetManifest(path);
+  EXPECT_EQ(setFiles(dir).size(), 2 + m.entries.size());
+  EXPECT_EQ(std::filesystem::path(m.scene.file).parent_path().parent_path().string(), "s.bricks");
+}
+
+// Two outputs whose names share a stem (s.vgrid and s.other both put their bricks under s.bricks/) never share a
+// file: writing, rewriting or failing one leaves the other readable.
+TEST(GridSet, TwoOutputsInOneFolderNeverShareAFile) {
+  testing::ScratchDir dir("gridset_two");
+  VoxelizeOptions o;
+  o.dims = std::array<uint32_t, 3>{6, 5, 4};
+  const Scene a = sceneWithPlane(3), b = sceneWithPlane(4);
+  writeGridSet(dir.file("s.vgrid"), a, o, {2, 2, 2});
+  writeGridSet(dir.file("s.other"), b, o, {2, 2, 2});
+  writeGridSet(dir.file("s.other"), b, o, {2, 1, 1});
+  EXPECT_THROW(writeGridSet(dir.file("s.other"), b, optionsCancellingAfter(2), {2, 2, 2}), Error);
+  expectSameGrid(readGridSet(dir.file("s.vgrid")).grid, voxelizeScene(a, o));
+  expectSameGrid(readGridSet(dir.file("s.other")).grid, voxelizeScene(b, o));
+}
+
+// A grid file written over a set (no --bricks) replaces it whole: vox-voxelize removes the old set's files, and only
+// files of the set layout that are the ones listed (size and checksum): a manifest cannot make it remove others.
+TEST(GridSet, OnlyTheReplacedSetsOwnFilesAreRemoved) {
+  testing::ScratchDir dir("gridset_remove");
+  const std::string path = dir.file("s.vgrid");
+  VoxelizeOptions o;
+  o.dims = std::array<uint32_t, 3>{6, 5, 4};
+  const GridSetManifest m = writeGridSet(path, sceneWithPlane(3), o, {2, 2, 1});
+  ASSERT_GE(m.entries.size(), 2u);
+  GridSetManifest lie = m;
+  writeFileAtomically(dir.file("keep.txt"), "user data");
+  lie.entries[0].file = "keep.txt";  // not a layout name
+  lie.entries[1].fileChecksum ^= 1;  // a layout name, but not the file listed
+  removeGridSetFiles(path, lie);
+  EXPECT_TRUE(std::filesystem::exists(dir.file("keep.txt")));
+  EXPECT_TRUE(std::filesystem::exists(dir.file(m.entries[1].file)));
+  EXPECT_FALSE(std::filesystem::exists(dir.file(m.scene.file)));
+  removeGridSetFiles(path, m);
+  EXPECT_EQ(setFiles(dir), (std::vector<std::string>{"keep.txt", "s.vgrid"}));
+}
+
+// "-o foo.bricks --bricks ...": its brick folder would have the manifest's name. Refused before any file is made.
+TEST(GridSet, AnOutputNamedLikeItsBrickFolderIsRefusedUpFront) {
+  testing::ScratchDir dir("gridset_name");
+  VoxelizeOptions o;
+  o.dims = std::array<uint32_t, 3>{6, 5, 4};
+  try {
+    writeGridSet(dir.file("foo.bricks"), sceneWithPlane(3), o, {2, 2, 1});
+    ADD_FAILURE() << "accepted";
+  } catch (const OutputError& e) {
+    EXPECT_NE(std::string(e.what()).find("foo.bricks"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(setFiles(dir), std::vector<std::string>{});
+  EXPECT_TRUE(std::filesystem::is_empty(dir.path()));
+}
+
+// A set's scene file replaced by a large file is refused by its size before it is read (2 GiB, sparse: reading it
+// whole took 11 s and 2.1 GB).
+TEST(GridSet, ASceneFileOfTheWrongSizeIsRefusedBeforeItIsRead) {
+  testing::ScratchDir dir("gridset_bigscene");
+  const std::string path = dir.file("s.vgrid");
+  VoxelizeOptions o;
+  o.dims = std::array<uint32_t, 3>{6, 5, 4};
+  const GridSetManifest m = writeGridSet(path, sceneWithPlane(3), o, {2, 2, 1});
+  std::filesystem::resize_file(dir.file(m.scene.file), uint64_t(2) << 30);
+  try {
+    readGridSet(path);
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("scene.vgrid: not the scene file"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("size differs"), std::string::npos) << e.what();
+  }
+}
+
+// A cell is occupied or solid, never both: a file whose solid run covers an occupied cell is refused (vox-info
+// counted such a cell twice while the exports wrote it once).
+TEST(GridSet, ASolidRunOverAnOccupiedCellIsRefused) {
+  testing::ScratchDir dir("gridset_overlap");
+  const Scene scene = sceneWithPlane(3);
+  VoxelizeOptions o;
+  o.dims = std::array<uint32_t, 3>{6, 5, 4};
+  Grid g = voxelizeScene(scene, o);
+  ASSERT_GT(g.occupiedCount(), 0u);
+  g.solidRuns = {{g.cellKeys[0], 1}};
+  try {
+    decodeGridFile(encodeGridFile(scene, g), "g.vgrid");
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("covers the occupied cell"), std::string::npos) << e.what();
+  }
+  g.solidRuns = {{0, g.cellKeys[0]}};  // up to the cell: accepted when it is not cell 0
+  if (g.cellKeys[0] > 0) {
+    EXPECT_NO_THROW(decodeGridFile(encodeGridFile(scene, g), "g.vgrid"));
+  }
+  // The same in a brick of a set.
+  const std::string path = dir.file("s.vgrid");
+  const GridSetManifest m = writeGridSet(path, scene, o, {1, 1, 1});
+  Grid brick = readBrick(path, m, 0, scene.boundedCount());
+  brick.solidRuns = {{brick.cellKeys.back(), 1}};
+  GridSetManifest lie = m;
+  lie.entries[0] = writeBrickFile(path, m, m.entries[0].index, brick);
+  writeFileAtomically(path, encodeGridSetManifest(lie));
+  try {
+    readGridSet(path);
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("covers the occupied cell"), std::string::npos) << e.what();
+  }
 }
 
 // --fill over a set gives the single grid's solid cells, run for run, for closed (flood) and open (winding number)
@@ -442,8 +589,8 @@ TEST(GridSet, CorruptBricksAndForeignSceneFilesAreRefused) {
     EXPECT_NE(std::string(e.what()).find("manifest"), std::string::npos) << e.what();
   }
   // Another set's scene file in place of this one's.
-  writeGridSet(dir.file("t.vgrid"), sceneWithPlane(4), o, {1, 1, 1});
-  std::filesystem::copy_file(dir.file("t.bricks/scene.vgrid"), dir.file("s.bricks/scene.vgrid"),
+  const GridSetManifest t = writeGridSet(dir.file("t.vgrid"), sceneWithPlane(4), o, {1, 1, 1});
+  std::filesystem::copy_file(dir.file(t.scene.file), dir.file(m.scene.file),
                              std::filesystem::copy_options::overwrite_existing);
   try {
     readGridSet(path);

@@ -65,8 +65,9 @@ if [ $SANITIZED = 0 ]; then
     compare_set "bunny_${b// /x}" "$S/scene5_07_bunny_mesh_1k.txt" "--grid 15 15 12" "$b"
   done
 fi
-# Bricks are files of their own, named by the manifest, inside NAME.bricks/ beside it.
-[ "$(ls "$T/spheres_set.bricks" | wc -l)" -ge 2 ] || { echo "FAIL brick files"; fails=$((fails + 1)); }
+# Bricks are files of their own, named by the manifest, inside a generation folder NAME.bricks/gHEX/ beside it.
+gen() { ls -d "$T/$1.bricks"/g* | head -1; }  # gen TAG: the one generation folder of set TAG
+[ "$(ls "$(gen spheres_set)" | wc -l)" -ge 2 ] || { echo "FAIL brick files"; fails=$((fails + 1)); }
 
 # Traced images and exported meshes of a set equal those of the single grid, byte for byte.
 for mode in shade voxels count normals depth; do
@@ -144,11 +145,68 @@ expect_err "brick folder blocked" "blocked.bricks"
 [ ! -e "$T/blocked.vgrid" ] || { echo "FAIL failed set left a manifest"; fails=$((fails + 1)); }
 check "set to a device" 3 "$V" "$S/scene5_01_sphere.txt" -o /dev/null --grid 8 8 8 --bricks 2 2 2
 expect_err "set to a device" "regular file"
-# A brick that cannot be written (a folder in its place): exit 3, no manifest.
-mkdir -p "$T/stuck.bricks/b_0_0_0.vgrid"
-check "brick write fails" 3 "$V" "$S/scene5_01_sphere.txt" -o "$T/stuck.vgrid" --grid 8 8 8 --bricks 2 2 2
-expect_err "brick write fails" "b_0_0_0.vgrid"
+# A brick that cannot be written (larger than the file-size limit; the scene file is not): exit 3 with the message
+# (not a death by SIGXFSZ), no manifest, and the new set's folder gone with it.
+late_failure() {  # late_failure OUT: a 160^3 sphere in 2x2x2 bricks of about 300 KB each, under a 64 KiB limit
+  (ulimit -f 64; exec "$V" "$S/scene5_01_sphere.txt" -o "$1" --grid 160 160 160 --bricks 2 2 2 -q)
+}
+check "brick write fails" 3 late_failure "$T/stuck.vgrid"
+expect_err "brick write fails" "b_._._.\.vgrid: cannot write: File too large"
 [ ! -e "$T/stuck.vgrid" ] || { echo "FAIL failed brick left a manifest"; fails=$((fails + 1)); }
+[ -z "$(find "$T/stuck.bricks" -type f 2>/dev/null)" ] || { echo "FAIL failed set left files"; fails=$((fails + 1)); }
+
+# Issue 23: a rerun that fails late or is interrupted leaves the old set whole (vox-info reads it as before) and no
+# file of its own; a rerun that succeeds replaces it and removes the old set's files.
+files_of() { (cd "$T" && find "$1.vgrid" "$1.bricks" -type f 2>/dev/null | sort); }
+check "old set" 0 "$V" "$S/bunny_1k.obj" -o "$T/rr.vgrid" --res 20 --bricks 3 3 3 -q
+check "old set info" 0 "$I" "$T/rr.vgrid" --json --cells --primitives
+mv "$T/out" "$T/rr.json"
+files_of rr >"$T/rr.files"
+check "rerun fails late" 3 late_failure "$T/rr.vgrid"
+same "old set's files after a failed rerun" "$T/rr.files" <(files_of rr)
+check "old set after a failed rerun" 0 "$I" "$T/rr.vgrid" --json --cells --primitives
+same "old set reads as before after a failed rerun" "$T/rr.json" "$T/out"
+# Interrupted once it has written bricks (SIGINT, as Ctrl-C): exit 130, the old set whole, nothing of the new one.
+# Job control on: a background job of a script otherwise starts with SIGINT ignored, which the tools respect.
+set -m
+"$V" "$SEED/meshes/bun_zipper.ply" -o "$T/rr.vgrid" --res 400 --bricks 8 8 8 -q 2>"$T/err" &
+pid=$!
+set +m
+for _ in $(seq 400); do
+  [ -n "$(find "$T/rr.bricks" -mindepth 2 -name 'b_*' 2>/dev/null | grep -v -F -f "$T/rr.files")" ] && break
+  sleep 0.05
+done
+kill -INT $pid
+wait $pid
+code=$?
+[ $code = 130 ] || { echo "FAIL interrupted rerun: exit $code, expected 130"; cat "$T/err"; fails=$((fails + 1)); }
+same "old set's files after an interrupted rerun" "$T/rr.files" <(files_of rr)
+check "old set after an interrupted rerun" 0 "$I" "$T/rr.vgrid" --json --cells --primitives
+same "old set reads as before after an interrupted rerun" "$T/rr.json" "$T/out"
+check "rerun succeeds" 0 "$V" "$S/bunny_1k.obj" -o "$T/rr.vgrid" --res 24 --bricks 5 5 5 -q
+[ -z "$(comm -12 "$T/rr.files" <(files_of rr) | grep -v '^rr.vgrid$')" ] ||
+  { echo "FAIL a replaced set's files stayed"; fails=$((fails + 1)); }
+check "rerun as a single grid" 0 "$V" "$S/bunny_1k.obj" -o "$T/rr.vgrid" --res 24 -q
+[ "$(files_of rr)" = rr.vgrid ] || { echo "FAIL a set replaced by a grid file left files"; files_of rr; fails=$((fails + 1)); }
+
+# Two outputs in one folder whose names share a stem (both under s2.bricks/) never share a file.
+check "first of two" 0 "$V" "$S/bunny_1k.obj" -o "$T/s2.vgrid" --res 20 --bricks 2 2 2 -q
+check "first of two info" 0 "$I" "$T/s2.vgrid" --json --cells
+mv "$T/out" "$T/s2.json"
+check "second of two" 0 "$V" "$S/scene5_01_sphere.txt" -o "$T/s2.other" --grid 8 8 8 --bricks 2 2 2 -q
+check "second of two again" 0 "$V" "$S/scene5_01_sphere.txt" -o "$T/s2.other" --grid 9 9 9 --bricks 2 2 2 -q
+check "first of two still read" 0 "$I" "$T/s2.vgrid" --json --cells
+same "first of two unchanged" "$T/s2.json" "$T/out"
+check "second of two read" 0 "$I" "$T/s2.other" --json
+# "-o foo.bricks": its brick folder would take the manifest's name; refused before any work.
+check "set named like its folder" 3 "$V" "$S/scene5_01_sphere.txt" -o "$T/foo.bricks" --grid 8 8 8 --bricks 2 2 2
+expect_err "set named like its folder" "foo.bricks: cannot write a grid set under this name"
+[ ! -e "$T/foo.bricks" ] || { echo "FAIL refused set left files"; fails=$((fails + 1)); }
+# A scene file replaced by a 2 GiB (sparse) file: refused by its size, before it is read.
+check "set for a huge scene file" 0 "$V" "$S/scene5_01_sphere.txt" -o "$T/hs.vgrid" --grid 8 8 8 --bricks 2 2 2 -q
+truncate -s 2G "$(gen hs)/scene.vgrid"
+check "huge scene file" 2 timeout 10 "$I" "$T/hs.vgrid"
+expect_err "huge scene file" "scene.vgrid: not the scene file .* names (size differs"
 
 # Bad sets: one line naming the file, exit 2.
 cp "$T/spheres_set.vgrid" "$T/bad.vgrid"
@@ -158,22 +216,22 @@ expect_err "corrupt manifest" "bad.vgrid: byte .*checksum"
 head -c 50 "$T/spheres_set.vgrid" >"$T/short.vgrid"
 check "truncated manifest" 2 "$I" "$T/short.vgrid"
 expect_err "truncated manifest" "short.vgrid: truncated"
-first=$(ls "$T/spheres_set.bricks" | grep "^b_" | head -1)
-mv "$T/spheres_set.bricks/$first" "$T/moved.vgrid"
+first=$(ls "$(gen spheres_set)" | grep "^b_" | head -1)
+mv "$(gen spheres_set)/$first" "$T/moved.vgrid"
 check "missing brick" 2 "$TR" "$T/spheres_set.vgrid" -o "$T/m.png"
 expect_err "missing brick" "$first"
 [ ! -e "$T/m.png" ] || { echo "FAIL image written from a broken set"; fails=$((fails + 1)); }
-cp "$T/squashed.vgrid" "$T/spheres_set.bricks/$first"  # another grid in its place
+cp "$T/squashed.vgrid" "$(gen spheres_set)/$first"  # another grid in its place
 check "foreign brick" 2 "$E" "$T/spheres_set.vgrid" -o "$T/m.ply"
 expect_err "foreign brick" "not the brick"
 # The scene file, stored once: missing or another set's is named; a brick opened directly is named as one.
-cp "$T/plane_set.bricks/scene.vgrid" "$T/spheres_set.bricks/scene.vgrid"
+cp "$(gen plane_set)/scene.vgrid" "$(gen spheres_set)/scene.vgrid"
 check "foreign scene file" 2 "$I" "$T/spheres_set.vgrid"
-expect_err "foreign scene file" "spheres_set.bricks/scene.vgrid: not the scene file"
-rm "$T/plane_set.bricks/scene.vgrid"
+expect_err "foreign scene file" "spheres_set.bricks/g[0-9a-f]*/scene.vgrid: not the scene file"
+rm "$(gen plane_set)/scene.vgrid"
 check "missing scene file" 2 "$TR" "$T/plane_set.vgrid" -o "$T/m.png"
-expect_err "missing scene file" "plane_set.bricks/scene.vgrid"
-check "brick opened directly" 2 "$I" "$T/bbox_set.bricks/$(ls "$T/bbox_set.bricks" | grep '^b_' | head -1)"
+expect_err "missing scene file" "plane_set.bricks/g[0-9a-f]*/scene.vgrid"
+check "brick opened directly" 2 "$I" "$(gen bbox_set)/$(ls "$(gen bbox_set)" | grep '^b_' | head -1)"
 expect_err "brick opened directly" "a brick of a grid set"
 
 echo "grid_set.sh: $passes passed, $fails failed"

@@ -92,16 +92,50 @@ fill_case() {  # fill_case TAG SCENE "ARGS" "BRICKS" "RANK COUNTS"
 fill_case fbunny "$S/scene5_07_bunny_mesh_1k.txt" "--grid 15 15 12" "3 2 2" "$SOME_K"
 fill_case fopen "${VOX_SEED_DIR:-$SRC/../shared/seed-scenes}/meshes/bun_zipper.ply" "--res 20" "7 5 3" "2"
 
-# A failing rank: one brick cannot be written (a folder in its place). The run fails with that message, exit 3, on
-# every rank count, and no manifest is written.
+# A failing rank: bricks cannot be written (each about 300 KB, over a 64 KiB file-size limit; the scene file is
+# small). The run fails with that message, exit 3, on every rank count; no manifest, and no file of the new set:
+# rank 0 removes its generation folder once every rank has stopped. Over an old set, that set stays whole. The limit
+# is set inside each rank (mpirun's own shared-memory files would exceed it; TCP between ranks instead), and the tool
+# turns SIGXFSZ into EFBIG itself, so the write fails with a message.
+LIMITED=(--mca btl self,tcp bash -c 'ulimit -f 64; exec "$@"' _)
 for K in 1 3; do
-  mkdir -p "$T/stuck$K.bricks/b_1_0_0.vgrid"
-  check "failing rank K=$K" 3 $RUN $K "$M" "$S/scene5_07_bunny_mesh_1k.txt" -o "$T/stuck$K.vgrid" --grid 15 15 12 \
-    --bricks 3 2 2 -q
-  grep -q "b_1_0_0.vgrid" "$T/err" || { echo "FAIL failing rank K=$K: message lacks the brick"; cat "$T/err"; fails=$((fails + 1)); }
+  check "failing rank K=$K" 3 $RUN $K "${LIMITED[@]}" "$M" "$S/scene5_01_sphere.txt" -o "$T/stuck$K.vgrid" --grid 160 160 160 --bricks 2 2 2 -q
+  grep -q "b_._._.\.vgrid" "$T/err" || { echo "FAIL failing rank K=$K: message lacks the brick"; cat "$T/err"; fails=$((fails + 1)); }
   [ "$(grep -c error "$T/err")" = 1 ] || { echo "FAIL failing rank K=$K: not one error line"; cat "$T/err"; fails=$((fails + 1)); }
   [ ! -e "$T/stuck$K.vgrid" ] || { echo "FAIL failing rank K=$K left a manifest"; fails=$((fails + 1)); }
+  [ -z "$(find "$T/stuck$K.bricks" -type f 2>/dev/null)" ] || { echo "FAIL failing rank K=$K left files"; fails=$((fails + 1)); }
 done
+files_of() { (cd "$T" && find "$1.vgrid" "$1.bricks" -type f 2>/dev/null | sort); }
+check "old set" 0 $RUN 2 "$M" "$S/bunny_1k.obj" -o "$T/rr.vgrid" --res 20 --bricks 3 3 3 -q
+check "old set info" 0 "$I" "$T/rr.vgrid" --json --cells --primitives
+mv "$T/out" "$T/rr.json"
+files_of rr >"$T/rr.files"
+check "rerun with a failing rank" 3 $RUN 3 "${LIMITED[@]}" "$M" "$S/scene5_01_sphere.txt" -o "$T/rr.vgrid" --grid 160 160 160 --bricks 2 2 2 -q
+same "old set's files after a failing rank" "$T/rr.files" <(files_of rr)
+check "old set after a failing rank" 0 "$I" "$T/rr.vgrid" --json --cells --primitives
+same "old set reads as before after a failing rank" "$T/rr.json" "$T/out"
+# A rank killed (SIGTERM) once bricks are written: its handler removes the new set's folder, mpirun ends the job, no
+# manifest is written (rank 0 waits for every rank's outcome first); the old set stays whole.
+$RUN 2 "$M" "${VOX_SEED_DIR:-$SRC/../shared/seed-scenes}/meshes/bun_zipper.ply" -o "$T/rr.vgrid" --res 1600 \
+  --bricks 8 8 8 -q 2>"$T/err" &
+pid=$!
+for _ in $(seq 600); do
+  [ -n "$(find "$T/rr.bricks" -mindepth 2 -name 'b_*' 2>/dev/null | grep -v -F -f "$T/rr.files")" ] && break
+  sleep 0.05
+done
+pkill -TERM -n -P $pid  # the newest rank
+wait $pid
+code=$?
+[ $code != 0 ] || { echo "FAIL a run with a killed rank exited 0"; fails=$((fails + 1)); }
+sleep 1  # ranks end after mpirun reports
+same "old set's files after a killed rank" "$T/rr.files" <(files_of rr)
+check "old set after a killed rank" 0 "$I" "$T/rr.vgrid" --json --cells --primitives
+same "old set reads as before after a killed rank" "$T/rr.json" "$T/out"
+# Every error line is escaped like vox-voxelize's: a control byte of a scene's name never reaches the terminal raw.
+esc=$(printf 'bad\033name.obj')
+check "control bytes in a name" 2 $RUN 2 "$M" "$T/$esc" -o "$T/x.vgrid" --bricks 1 1 1 -q
+grep -q -F 'bad\x1bname.obj' "$T/err" && ! grep -q "$(printf '\033')" "$T/err" ||
+  { echo "FAIL control bytes printed raw"; cat -v "$T/err"; fails=$((fails + 1)); }
 check "bad scene K=2" 2 $RUN 2 "$M" "$T/missing.obj" -o "$T/x.vgrid" --bricks 1 1 1 -q
 [ "$(grep -c "missing.obj" "$T/err")" = 1 ] || { echo "FAIL bad scene: one line naming it"; cat "$T/err"; fails=$((fails + 1)); }
 check "no mode" 1 $RUN 1 "$M" -o "$T/x.vgrid"

@@ -22,6 +22,7 @@
 #include "vox/io/input_file.h"
 #include "vox/voxelize/fill.h"
 #include "vox/voxelize/voxelize.h"
+#include "broadcast.h"
 #include "work_queue.h"
 
 namespace {
@@ -167,20 +168,13 @@ int32_t capture(const std::function<void()>& body, std::string& message) {
   try {
     body();
     return vox::kExitOk;
-  } catch (const vox::UsageError& e) {
-    message = e.what();
-    return vox::kExitUsage;
-  } catch (const vox::OutputError& e) {
-    message = e.what();
-    return vox::kExitCannotWrite;
-  } catch (const std::bad_alloc&) {
-    message = "out of memory";
-    return vox::kExitBadInput;
-  } catch (const std::exception& e) {
-    message = e.what();
-    return vox::kExitBadInput;
+  } catch (...) {
+    return vox::currentExceptionExit(message);
   }
 }
+
+// Every error line of every rank: the tools' one format (vox::errorLine: escaped, one line).
+void printError(const std::string& message) { std::fputs(vox::errorLine("vox-voxelize-mpi", message).c_str(), stderr); }
 
 double peakMemoryMb() {
   rusage usage{};
@@ -232,9 +226,11 @@ int runSet(const Options& opt, int rank, int size) {
   std::vector<std::vector<uint32_t>> candidates;
   std::vector<uint64_t> order;
   const VoxelizeOptions vo = voxelizeOptions(opt);
+  std::unique_ptr<GridSetOutput> output;  // rank 0 makes the set's generation folder; the others register it
   mine.code = capture(
       [&] {
         checkOutputPath(opt.output, {opt.scene});
+        checkGridSetOutput(opt.output);
         scene = loadScene(opt.scene);
         namingScene(opt.scene, [&] {
           plan = planGrid(scene, vo);
@@ -242,15 +238,28 @@ int runSet(const Options& opt, int rank, int size) {
           if (vo.bounds) plan.outsidePrims = primitivesOutside(scene, plan);
           candidates = brickCandidates(scene, plan, bricks, vo.memoryLimitBytes);
         });
-        // Every rank encodes the scene file to know its checksum (the bricks name it); rank 0 writes it.
-        if (rank == 0) makeBrickFolder(opt.output);
-        set = {plan.bounds, plan.dims, plan.method, bricks, writeGridSetScene(opt.output, scene, plan, rank == 0), {}};
-        for (uint64_t b = 0; b < candidates.size(); ++b)
-          if (!candidates[b].empty()) order.push_back(b);
-        std::stable_sort(order.begin(), order.end(),
-                         [&](uint64_t a, uint64_t b) { return candidates[a].size() > candidates[b].size(); });
+        if (rank == 0) output = std::make_unique<GridSetOutput>(opt.output);
       },
       mine.message);
+  const std::string folder = mpi::broadcastString(MPI_COMM_WORLD, output ? output->folder() : std::string());
+  if (mine.code == kExitOk)
+    mine.code = capture(
+        [&] {
+          if (folder.empty()) fail<Error>("rank 0 could not start the set");
+          if (rank != 0) output = std::make_unique<GridSetOutput>(opt.output, folder);
+          // Every rank encodes the scene file to know its checksum (the bricks name it); rank 0 writes it.
+          set = {plan.bounds,
+                 plan.dims,
+                 plan.method,
+                 bricks,
+                 writeGridSetScene(opt.output, folder, scene, plan, rank == 0),
+                 {}};
+          for (uint64_t b = 0; b < candidates.size(); ++b)
+            if (!candidates[b].empty()) order.push_back(b);
+          std::stable_sort(order.begin(), order.end(),
+                           [&](uint64_t a, uint64_t b) { return candidates[a].size() > candidates[b].size(); });
+        },
+        mine.message);
   int anyFailed = mine.code;
   // Also the barrier that makes the brick folder exist before any rank writes into it.
   MPI_Allreduce(MPI_IN_PLACE, &anyFailed, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
@@ -283,8 +292,7 @@ int runSet(const Options& opt, int rank, int size) {
     for (size_t r = 0; r < all.size() && code == kExitOk; ++r)
       if (all[r].code != kExitOk) {
         code = all[r].code;
-        std::fprintf(stderr, "vox-voxelize-mpi: error: %s%s\n",
-                     size > 1 ? ("rank " + std::to_string(r) + ": ").c_str() : "", all[r].message.c_str());
+        printError((size > 1 ? "rank " + std::to_string(r) + ": " : std::string()) + all[r].message);
       }
     if (code == kExitOk) {
       std::string message;
@@ -304,10 +312,10 @@ int runSet(const Options& opt, int rank, int size) {
                 if (!opt.common.quiet)
                   std::fprintf(stderr, "vox-voxelize-mpi: fill: %s\n", describeFill(report).c_str());
               });
-            writeGridSetManifest(opt.output, m);
+            output->commit(m);  // the manifest, then the replaced set's files removed
           },
           message);
-      if (code != kExitOk) std::fprintf(stderr, "vox-voxelize-mpi: error: %s\n", message.c_str());
+      if (code != kExitOk) printError(message);
     }
     if (opt.stats) printRankStats(all, std::chrono::duration<double>(Clock::now() - start).count());
   }
@@ -405,7 +413,7 @@ int runBatch(const Options& opt, int rank, int size) {
   if (rank == 0) {
     if (all[0].code != kExitOk) {  // the list or the folder: every rank saw the same
       code = all[0].code;
-      std::fprintf(stderr, "vox-voxelize-mpi: error: %s\n", all[0].message.c_str());
+      printError(all[0].message);
     } else {
       std::vector<std::pair<uint64_t, std::pair<int32_t, std::string>>> results;
       for (const auto& o : all) results.insert(results.end(), o.scenes.begin(), o.scenes.end());
@@ -415,7 +423,7 @@ int runBatch(const Options& opt, int rank, int size) {
         if (result.first != kExitOk) {
           ++failed;
           code = std::max(code, int(result.first));
-          std::fprintf(stderr, "vox-voxelize-mpi: error: %s\n", result.second.c_str());
+          printError(result.second);
         }
       if (failed && !opt.common.quiet)
         std::fprintf(stderr, "vox-voxelize-mpi: %zu of %zu scenes failed\n", failed, scenes.size());

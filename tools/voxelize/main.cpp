@@ -14,6 +14,7 @@
 #include "vox/import/import.h"
 #include "vox/io/input_file.h"
 #include "vox/core/progress.h"
+#include "vox/core/tool.h"
 #include "vox/voxelize/voxelize.h"
 
 namespace {
@@ -36,7 +37,7 @@ void reportFill(const Options& opt, const vox::FillReport& report) {
   if (opt.common.quiet) return;
   std::fprintf(stderr, "vox-voxelize: fill: %s\n", vox::describeFill(report).c_str());
   if (const std::string w = vox::fillWarning(report); !w.empty())
-    std::fprintf(stderr, "vox-voxelize: warning: %s: fill: %s\n", opt.scene.c_str(), w.c_str());
+    std::fputs(vox::warningLine("vox-voxelize", opt.scene + ": fill: " + w).c_str(), stderr);
 }
 
 // --bricks: the grid set of docs/grid-format.md, brick after brick, then the fill over the bricks' cells.
@@ -109,10 +110,11 @@ int run(const Options& opt) {
 
   // Before the scene is read: `-o scene.glb` would destroy the scene.
   checkOutputPath(opt.output, {opt.scene});
+  if (!opt.bricks.empty()) checkGridSetOutput(opt.output);  // "-o foo.bricks": refused before any work
+  const std::optional<GridSetManifest> previousSet = opt.bricks.empty() ? previousGridSet(opt.output) : std::nullopt;
   const Scene scene = loadScene(opt.scene);
   if (!opt.common.quiet)
-    for (const auto& w : scene.warnings)
-      std::fprintf(stderr, "vox-voxelize: warning: %s\n", quoteInput(w, 600).c_str());  // one line, escaped
+    for (const auto& w : scene.warnings) std::fputs(warningLine("vox-voxelize", w).c_str(), stderr);
   if (!opt.bricks.empty()) return runSet(opt, scene, vo, start);
   ProgressBar bar("voxelizing", opt.common.quiet);
   vo.progress = [&](double f) {
@@ -142,10 +144,12 @@ int run(const Options& opt) {
     fail<InputError>(opt.scene, ": ", e.what());
   }
   if (!grid.outsidePrims.empty() && !opt.common.quiet)
-    std::fprintf(stderr,
-                 "vox-voxelize: warning: %s: %zu primitives stick out of the given bounds (traced separately)\n",
-                 opt.scene.c_str(), grid.outsidePrims.size());
+    std::fputs(warningLine("vox-voxelize", opt.scene + ": " + std::to_string(grid.outsidePrims.size()) +
+                                               " primitives stick out of the given bounds (traced separately)")
+                   .c_str(),
+               stderr);
   writeGridFile(opt.output, scene, grid);
+  if (previousSet) removeGridSetFiles(opt.output, *previousSet);  // a grid file replaced a set: its files go too
 
   if (opt.stats) {
     rusage usage{};
@@ -186,7 +190,8 @@ int main(int argc, char** argv) {
                "number| >= 0.5 for open ones; says which on stderr");
   app.add_option("--bricks", opt.bricks,
                  "Write a grid set: OUT is a manifest naming the scene file and one brick file per non-empty brick "
-                 "of BX x BY x BZ bricks (in OUT_NAME.bricks/ beside it), voxelized one brick at a time; with "
+                 "of BX x BY x BZ bricks (in a new folder OUT_NAME.bricks/gHEX/ beside it; the old set is removed once "
+                 "the new one is in place), voxelized one brick at a time; with "
                  "--fill, the fill runs over all bricks' cells afterwards")
       ->expected(3)
       ->check(CLI::Range(1u, vox::kMaxCellsPerAxis));

@@ -71,6 +71,17 @@ void checkSolidRuns(const std::vector<CellRun>& runs, uint64_t cellCount, const 
   }
 }
 
+void checkSolidRunsMissCells(const std::vector<uint64_t>& sortedKeys, const std::vector<CellRun>& runs,
+                             const std::string& what) {
+  size_t c = 0;
+  for (size_t r = 0; r < runs.size() && c < sortedKeys.size(); ++r) {
+    while (c < sortedKeys.size() && sortedKeys[c] < runs[r].first) ++c;
+    if (c < sortedKeys.size() && sortedKeys[c] - runs[r].first < runs[r].count)
+      fail<InputError>(what, ": solid run ", r, " covers the occupied cell ", sortedKeys[c],
+                       " (a cell is occupied or solid, not both)");
+  }
+}
+
 std::array<int64_t, 2> cellRange(const Box& bounds, const std::array<uint32_t, 3>& dims, int axis, double lo,
                                  double hi) {
   const double scale = double(dims[axis]) / (bounds.hi[axis] - bounds.lo[axis]);

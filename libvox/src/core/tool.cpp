@@ -21,34 +21,47 @@ namespace {
 constexpr size_t kMaxMessageBytes = 600;
 }  // namespace
 
-int runTool(const std::string& toolName, const std::function<int()>& body) {
+std::string errorLine(const std::string& toolName, const std::string& message) {
   // One line, whatever the message holds: a library message can quote hostile input (a 10 MB data URI, control
   // bytes), so it is escaped and cut here as a last guard.
-  auto report = [&](const char* message) {
-    std::fprintf(stderr, "%s: error: %s\n", toolName.c_str(), quoteInput(message, kMaxMessageBytes).c_str());
-  };
+  return toolName + ": error: " + quoteInput(message, kMaxMessageBytes) + "\n";
+}
+
+std::string warningLine(const std::string& toolName, const std::string& message) {
+  return toolName + ": warning: " + quoteInput(message, kMaxMessageBytes) + "\n";
+}
+
+int currentExceptionExit(std::string& message) {
   try {
-    return body();
+    throw;
   } catch (const OutputError& e) {
-    report(e.what());
+    message = e.what();
     return kExitCannotWrite;
   } catch (const UsageError& e) {
-    report(e.what());
+    message = e.what();
     return kExitUsage;
-  } catch (const LimitError& e) {
-    report(e.what());
-    return kExitBadInput;
-  } catch (const Error& e) {
-    report(e.what());
-    return kExitBadInput;
   } catch (const std::bad_alloc&) {
     // Every allocation that input drives is estimated and refused before it is made (LimitError); this is the
     // guard for what the estimates missed, so it says what to try.
-    report("out of memory (the request was larger than estimated; try a smaller grid or --threads 1)");
+    message = "out of memory (the request was larger than estimated; try a smaller grid or --threads 1)";
     return kExitBadInput;
   } catch (const std::exception& e) {
-    report(e.what());
+    message = e.what();  // InputError, LimitError and the rest: bad input
     return kExitBadInput;
+  } catch (...) {
+    message = "unknown error";
+    return kExitBadInput;
+  }
+}
+
+int runTool(const std::string& toolName, const std::function<int()>& body) {
+  try {
+    return body();
+  } catch (...) {
+    std::string message;
+    const int code = currentExceptionExit(message);
+    std::fputs(errorLine(toolName, message).c_str(), stderr);
+    return code;
   }
 }
 

@@ -3,8 +3,10 @@
 // OutputError with the old output untouched, never in a truncated file renamed over it.
 #include "vox/io/atomic_file.h"
 
+#include <dirent.h>
 #include <fcntl.h>
 #include <sys/stat.h>
+#include <sys/syscall.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -37,10 +39,36 @@ struct Slot {
   char path[kPathBytes];
 };
 std::array<Slot, kSlots> gSlots;
+// Folders of new files (TemporaryFolder), emptied and removed after the temporary files.
+constexpr size_t kFolderSlots = 8;
+std::array<Slot, kFolderSlots> gFolderSlots;
+
+// Unlinks every entry of a folder of plain files, then the folder. Only system calls: getdents64 through syscall()
+// because readdir() may allocate, which a signal handler must not.
+void removeFolderInHandler(const char* path) {
+  const int fd = ::open(path, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd >= 0) {
+    alignas(8) char buffer[4096];
+    for (;;) {
+      const long n = ::syscall(SYS_getdents64, fd, buffer, sizeof buffer);
+      if (n <= 0) break;
+      for (long at = 0; at < n;) {
+        const auto* entry = reinterpret_cast<const dirent64*>(buffer + at);
+        const char* name = entry->d_name;
+        if (!(name[0] == '.' && (name[1] == 0 || (name[1] == '.' && name[2] == 0)))) ::unlinkat(fd, name, 0);
+        at += entry->d_reclen;
+      }
+    }
+    ::close(fd);
+  }
+  ::rmdir(path);
+}
 
 extern "C" void removeTemporariesAndExit(int signal) {
   for (Slot& s : gSlots)
     if (s.state.load(std::memory_order_acquire) == kLive) ::unlink(s.path);
+  for (Slot& s : gFolderSlots)
+    if (s.state.load(std::memory_order_acquire) == kLive) removeFolderInHandler(s.path);
   ::_exit(128 + signal);
 }
 
@@ -57,23 +85,30 @@ void installSignalHandlers() {
       sigfillset(&act.sa_mask);  // one handler at a time: a second signal must not interrupt the unlinks
       ::sigaction(sig, &act, nullptr);
     }
+    // A write past RLIMIT_FSIZE then fails with EFBIG, which the writers report ("File too large") and which
+    // removes the temporary file, instead of SIGXFSZ killing the process with the temporary file left behind.
+    struct sigaction xfsz {};
+    if (::sigaction(SIGXFSZ, nullptr, &xfsz) == 0 && xfsz.sa_handler == SIG_DFL) ::signal(SIGXFSZ, SIG_IGN);
   });
 }
 
 // Returns the slot index, or -1 when the path is too long or all slots are taken (the file is then not removed on a
 // signal, which is the old behaviour, rather than refusing to write).
-int publishTemporary(const std::string& path) {
+template <size_t N>
+int publishIn(std::array<Slot, N>& slots, const std::string& path) {
   installSignalHandlers();
   if (path.size() >= kPathBytes) return -1;
-  for (size_t i = 0; i < kSlots; ++i) {
+  for (size_t i = 0; i < N; ++i) {
     int expected = kFree;
-    if (!gSlots[i].state.compare_exchange_strong(expected, kClaimed, std::memory_order_acquire)) continue;
-    std::memcpy(gSlots[i].path, path.c_str(), path.size() + 1);
-    gSlots[i].state.store(kLive, std::memory_order_release);
+    if (!slots[i].state.compare_exchange_strong(expected, kClaimed, std::memory_order_acquire)) continue;
+    std::memcpy(slots[i].path, path.c_str(), path.size() + 1);
+    slots[i].state.store(kLive, std::memory_order_release);
     return int(i);
   }
   return -1;
 }
+
+int publishTemporary(const std::string& path) { return publishIn(gSlots, path); }
 
 void unpublishTemporary(int slot) {
   if (slot >= 0) gSlots[size_t(slot)].state.store(kFree, std::memory_order_release);
@@ -263,6 +298,38 @@ void OutputFile::commit() {
   f.committed = true;
   unpublishTemporary(f.slot);
   syncFolder(path_);
+}
+
+TemporaryFolder::TemporaryFolder(const std::string& path, bool create) : path_(path), owner_(create) {
+  // Published before it exists, like a temporary file: no moment where a signal could leave it behind. A folder
+  // made by another rank is published without ownership: on a signal each rank removes what it can.
+  slot_ = publishIn(gFolderSlots, path_);
+  if (create && ::mkdir(path_.c_str(), 0777) != 0) {
+    const int err = errno;
+    if (slot_ >= 0) gFolderSlots[size_t(slot_)].state.store(kFree, std::memory_order_release);
+    slot_ = -1;
+    fail<OutputError>(path_, ": cannot create the folder: ", std::strerror(err));
+  }
+}
+
+TemporaryFolder::~TemporaryFolder() {
+  if (owner_) {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  keep();
+}
+
+void TemporaryFolder::keep() {
+  if (slot_ >= 0) gFolderSlots[size_t(slot_)].state.store(kFree, std::memory_order_release);
+  slot_ = -1;
+  owner_ = false;
+}
+
+void TemporaryFolder::discard() {
+  std::error_code ec;
+  std::filesystem::remove_all(path_, ec);
+  keep();
 }
 
 void writeFileAtomically(const std::string& path, std::string_view bytes) {

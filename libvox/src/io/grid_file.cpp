@@ -394,6 +394,7 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
     getSections(r, scene, grid);
   }
   checkCellTable(grid, scene.triangles.size() + scene.spheres.size(), name, cellsAt);
+  checkSolidRunsMissCells(grid.cellKeys, grid.solidRuns, name + ": solid runs");
   // The same checks as at import (singular ellipsoid transforms, cameras that cannot form an image, materials),
   // so a grid file that passes here traces and exports.
   validateScene(scene, name);

@@ -147,9 +147,23 @@ GridSetManifest readGridSetManifest(const std::string& path) {
   return decodeGridSetManifest(readInputFile(path, "grid-set manifest"), path);
 }
 
+namespace {
+
+// Throws InputError naming `path` unless it is a regular file of the listed size (`role`: "brick", "scene file").
+void requireListedSize(const std::string& setPath, const std::string& path, uint64_t size, const char* role) {
+  requireRegularFile(path, role);
+  std::error_code ec;
+  if (std::filesystem::file_size(path, ec) != size || ec)
+    fail<InputError>(path, ": not the ", role, " ", setPath, " names (size differs; rewritten since?)");
+}
+
+}  // namespace
+
 GridFile readGridSetScene(const std::string& setPath, const GridSetManifest& m) {
   // Refuses absolute names and names leaving the manifest's folder (after "..", symbolic links included).
   const std::string path = resolveInsideFolder(setPath, m.scene.file);
+  // The size first: a file put in its place (2 GiB, say) is refused before it is read.
+  requireListedSize(setPath, path, m.scene.fileSize, "scene file");
   const std::string bytes = readInputFile(path, "grid-set scene file");
   if (bytes.size() != m.scene.fileSize || headerChecksum(bytes) != m.scene.checksum)
     fail<InputError>(path, ": not the scene file ", setPath, " names (size or checksum differ; rewritten since?)");
@@ -178,11 +192,7 @@ namespace {
 // their listed sizes (which bound the counts, decodeGridSetManifest) before arrays are sized by them.
 void requireListedBricks(const std::string& setPath, const GridSetManifest& m, size_t first, size_t end) {
   for (size_t i = first; i < end; ++i) {
-    const std::string brick = resolveInsideFolder(setPath, m.entries[i].file);
-    requireRegularFile(brick, "brick file");
-    std::error_code ec;
-    if (std::filesystem::file_size(brick, ec) != m.entries[i].fileSize || ec)
-      fail<InputError>(brick, ": not the brick ", setPath, " names (size differs; rewritten since?)");
+    requireListedSize(setPath, resolveInsideFolder(setPath, m.entries[i].file), m.entries[i].fileSize, "brick file");
   }
 }
 

@@ -104,6 +104,7 @@ Grid decodeBrickFile(const std::string& bytes, const std::string& name, const Gr
   const CellWindow w = brickWindow(set.dims, set.bricks, index);
   checkCells(g, w, boundedCount, name, cellsAt);
   checkSolidRuns(g.solidRuns, g.cellCount(), name + ": solid runs at byte " + std::to_string(runsAt));
+  checkSolidRunsMissCells(g.cellKeys, g.solidRuns, name + ": solid runs at byte " + std::to_string(runsAt));
   for (const CellRun& run : g.solidRuns)
     if (!runInsideWindow(run, g.dims, w))
       fail<InputError>(name, ": solid runs at byte ", runsAt, ": a run outside its brick");

@@ -1,8 +1,12 @@
-// Writing a grid set: the scene file first, then each brick voxelized and written before the next starts (so one
-// brick's cells are in memory at a time), the fill's solid runs, the manifest last (so a failure anywhere leaves no
-// manifest).
+// Writing a grid set: a generation folder of its own, the scene file first, then each brick voxelized and written
+// before the next starts (so one brick's cells are in memory at a time), the fill's solid runs, the manifest last
+// (so a failure anywhere leaves the old set, or none), then the old set's files removed.
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <random>
+#include <regex>
 #include <system_error>
 
 #include "io/grid_set_header.h"
@@ -14,44 +18,133 @@ namespace vox {
 
 namespace {
 
-std::string brickFolderName(const std::string& setPath) {
-  return std::filesystem::path(setPath).stem().string() + ".bricks";
-}
+namespace fs = std::filesystem;
+
+std::string brickFolderName(const std::string& setPath) { return fs::path(setPath).stem().string() + ".bricks"; }
 
 std::string besideManifest(const std::string& setPath, const std::string& file) {
-  return (std::filesystem::path(setPath).parent_path() / file).string();
+  return (fs::path(setPath).parent_path() / file).string();
+}
+
+// 64 random bits: two outputs, two runs, or two ranks of two runs never pick the same generation folder (and the
+// folder is created exclusively, so a clash costs another name, never a shared file).
+std::string randomGeneration() {
+  std::random_device device;
+  const uint64_t bits = (uint64_t(device()) << 32) ^ uint64_t(device());
+  char hex[20];
+  std::snprintf(hex, sizeof hex, "g%016llx", static_cast<unsigned long long>(bits));
+  return hex;
+}
+
+// Makes NAME.bricks/ when missing (it may hold other manifests' generations) and a new generation folder in it.
+std::unique_ptr<TemporaryFolder> makeGenerationFolder(const std::string& setPath, std::string& folder) {
+  const fs::path parent = fs::path(setPath).parent_path() / brickFolderName(setPath);
+  std::error_code ec;
+  fs::create_directory(parent, ec);
+  if (ec || !fs::is_directory(parent, ec))
+    fail<OutputError>(parent.string(), ": cannot create the brick folder",
+                      ec ? ": " + ec.message() : std::string(": a file of that name is in the way"));
+  for (int attempt = 0;; ++attempt) {
+    folder = brickFolderName(setPath) + "/" + randomGeneration();
+    if (fs::exists(besideManifest(setPath, folder), ec) && attempt < 8) continue;
+    return std::make_unique<TemporaryFolder>(besideManifest(setPath, folder), true);
+  }
+}
+
+// Whether `file` (a name the old manifest lists) is a name of the set layout of `setPath`: NAME.bricks/LEAF or
+// NAME.bricks/gHEX/LEAF, LEAF scene.vgrid or b_X_Y_Z.vgrid. Nothing else is ever removed.
+bool isSetLayoutName(const std::string& setPath, const std::string& file) {
+  static const std::regex layout(R"(^(g[0-9a-f]{16}/)?(scene|b_[0-9]{1,10}_[0-9]{1,10}_[0-9]{1,10})\.vgrid$)");
+  const std::string prefix = brickFolderName(setPath) + "/";
+  return file.size() > prefix.size() && file.compare(0, prefix.size(), prefix) == 0 &&
+         std::regex_match(file.substr(prefix.size()), layout);
+}
+
+// Removes `path` when it is a regular file (not a link) of `size` bytes whose header holds `checksum`.
+void removeListedFile(const std::string& path, uint64_t size, uint64_t checksum) {
+  std::error_code ec;
+  if (!fs::is_regular_file(fs::symlink_status(path, ec)) || fs::file_size(path, ec) != size || ec) return;
+  std::ifstream in(path, std::ios::binary);
+  char header[kSetHeaderSize] = {};
+  if (!in.read(header, sizeof header)) return;
+  if (headerChecksum(std::string(header, sizeof header)) != checksum) return;
+  in.close();
+  fs::remove(path, ec);
 }
 
 }  // namespace
 
-std::string brickFileName(const std::string& setPath, const std::array<uint32_t, 3>& index) {
-  return brickFolderName(setPath) + "/b_" + std::to_string(index[0]) + "_" + std::to_string(index[1]) + "_" +
-         std::to_string(index[2]) + ".vgrid";
+std::string brickFileName(const GridSetManifest& set, const std::array<uint32_t, 3>& index) {
+  return (fs::path(set.scene.file).parent_path() / ("b_" + std::to_string(index[0]) + "_" + std::to_string(index[1]) +
+                                                    "_" + std::to_string(index[2]) + ".vgrid"))
+      .string();
 }
 
-std::string sceneFileName(const std::string& setPath) { return brickFolderName(setPath) + "/scene.vgrid"; }
+std::string sceneFileName(const std::string& folder) { return folder + "/scene.vgrid"; }
 
-void makeBrickFolder(const std::string& setPath) {
-  const auto folder = std::filesystem::path(setPath).parent_path() / brickFolderName(setPath);
-  std::error_code ec;
+void checkGridSetOutput(const std::string& setPath) {
   // The manifest names the bricks by this folder, and readers refuse names with control bytes: refuse them before
   // writing a set no reader takes.
   if (hasControlByte(brickFolderName(setPath)))
     fail<OutputError>(quoteInput(setPath, 200), ": cannot write a grid set whose name holds control characters");
+  std::error_code ec;
   // A device or FIFO can take a grid's bytes but not a set: its bricks would go into /dev.
-  if (std::filesystem::exists(setPath, ec) && !std::filesystem::is_regular_file(setPath, ec))
+  if (fs::exists(setPath, ec) && !fs::is_regular_file(setPath, ec))
     fail<OutputError>(setPath, ": cannot write: a grid set's manifest must be a regular file");
-  std::filesystem::create_directory(folder, ec);
-  if (ec || !std::filesystem::is_directory(folder, ec))
-    fail<OutputError>(folder.string(), ": cannot create the brick folder",
-                      ec ? ": " + ec.message() : std::string(": a file of that name is in the way"));
+  if (fs::path(setPath).filename().string() == brickFolderName(setPath))
+    fail<OutputError>(setPath, ": cannot write a grid set under this name: its bricks go into the folder ",
+                      brickFolderName(setPath), " of the same name (name the set NAME.vgrid)");
 }
 
-GridSetScene writeGridSetScene(const std::string& setPath, const Scene& scene, const Grid& plan, bool write) {
+std::optional<GridSetManifest> previousGridSet(const std::string& path) {
+  try {
+    if (isGridSet(path)) return readGridSetManifest(path);
+  } catch (const Error&) {
+    // Missing, unreadable or corrupt: nothing this output can tell apart as a set's files.
+  }
+  return std::nullopt;
+}
+
+void removeGridSetFiles(const std::string& setPath, const GridSetManifest& old) {
+  std::vector<std::string> folders;
+  auto remove = [&](const std::string& file, uint64_t size, uint64_t checksum) {
+    if (!isSetLayoutName(setPath, file)) return;
+    removeListedFile(besideManifest(setPath, file), size, checksum);
+    const std::string folder = fs::path(file).parent_path().string();
+    if (folder != brickFolderName(setPath) && std::find(folders.begin(), folders.end(), folder) == folders.end())
+      folders.push_back(folder);
+  };
+  remove(old.scene.file, old.scene.fileSize, old.scene.checksum);
+  for (const BrickEntry& e : old.entries) remove(e.file, e.fileSize, e.fileChecksum);
+  std::error_code ec;
+  for (const std::string& folder : folders) fs::remove(besideManifest(setPath, folder), ec);  // only when empty
+}
+
+GridSetOutput::GridSetOutput(const std::string& setPath, const std::string& folder) : setPath_(setPath) {
+  checkGridSetOutput(setPath);
+  if (folder.empty()) {
+    previous_ = previousGridSet(setPath);
+    files_ = makeGenerationFolder(setPath, folder_);
+  } else {
+    folder_ = folder;
+    files_ = std::make_unique<TemporaryFolder>(besideManifest(setPath, folder), false);
+  }
+}
+
+void GridSetOutput::commit(const GridSetManifest& manifest) {
+  VOX_CHECK(fs::path(manifest.scene.file).parent_path().string() == folder_);
+  writeGridSetManifest(setPath_, manifest);
+  files_->keep();
+  if (previous_) removeGridSetFiles(setPath_, *previous_);
+  previous_.reset();
+}
+
+GridSetScene writeGridSetScene(const std::string& setPath, const std::string& folder, const Scene& scene,
+                               const Grid& plan, bool write) {
   Grid g = emptyGridLike(plan);
   g.outsidePrims = plan.outsidePrims;
   const std::string bytes = encodeGridFile(scene, g);
-  GridSetScene s{sceneFileName(setPath), bytes.size(), headerChecksum(bytes)};
+  GridSetScene s{sceneFileName(folder), bytes.size(), headerChecksum(bytes)};
   if (write) writeFileAtomically(besideManifest(setPath, s.file), bytes);
   return s;
 }
@@ -60,7 +153,7 @@ BrickEntry writeBrickFile(const std::string& setPath, const GridSetManifest& set
                           const Grid& cells) {
   BrickEntry e;
   e.index = index;
-  e.file = brickFileName(setPath, index);
+  e.file = brickFileName(set, index);
   e.occupied = cells.occupiedCount();
   e.references = cells.referenceCount();
   e.solid = cells.solidCount();
@@ -102,12 +195,14 @@ void writeGridSetManifest(const std::string& setPath, const GridSetManifest& man
 GridSetManifest writeGridSet(const std::string& setPath, const Scene& scene, const VoxelizeOptions& options,
                              const std::array<uint32_t, 3>& bricks, VoxelizeStats* stats, const FillOptions* fill,
                              FillReport* fillReport) {
+  checkGridSetOutput(setPath);  // before any work
   Grid plan = planGrid(scene, options);
   checkBrickCounts(plan.dims, bricks);
   if (options.bounds) plan.outsidePrims = primitivesOutside(scene, plan);
   const auto candidates = brickCandidates(scene, plan, bricks, options.memoryLimitBytes);
-  makeBrickFolder(setPath);
-  GridSetManifest m{plan.bounds, plan.dims, plan.method, bricks, writeGridSetScene(setPath, scene, plan), {}};
+  GridSetOutput output(setPath);
+  GridSetManifest m{
+      plan.bounds, plan.dims, plan.method, bricks, writeGridSetScene(setPath, output.folder(), scene, plan), {}};
   VoxelizeOptions brickOptions = options;
   brickOptions.progress = nullptr;
   for (uint64_t b = 0; b < candidates.size(); ++b) {
@@ -122,7 +217,7 @@ GridSetManifest writeGridSet(const std::string& setPath, const Scene& scene, con
     const FillReport report = fillGridSet(setPath, m, scene, *fill);
     if (fillReport) *fillReport = report;
   }
-  writeGridSetManifest(setPath, m);
+  output.commit(m);
   return m;
 }
 

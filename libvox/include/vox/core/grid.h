@@ -77,6 +77,11 @@ void appendSolidKey(std::vector<CellRun>& runs, uint64_t key);
 // Throws InputError (prefixed by `what`) unless the runs are sorted, disjoint, non-adjacent, non-empty and inside
 // a grid of `cellCount` cells.
 void checkSolidRuns(const std::vector<CellRun>& runs, uint64_t cellCount, const std::string& what);
+// Throws InputError (prefixed by `what`) when a solid run covers an occupied cell: a cell is occupied or solid,
+// never both (counting it twice would make vox-info and the exports disagree). `sortedKeys` ascending, `runs` as
+// checkSolidRuns accepts them. O(cells + runs).
+void checkSolidRunsMissCells(const std::vector<uint64_t>& sortedKeys, const std::vector<CellRun>& runs,
+                             const std::string& what);
 
 // Smallest index range [first, last] of cells on `axis` whose closed boxes meet [lo, hi] (clamped to the grid);
 // uses cellBoundary, so a coordinate exactly on a boundary yields both neighbouring cells. first > last when the

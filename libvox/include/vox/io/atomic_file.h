@@ -46,6 +46,32 @@ class OutputFile {
   std::unique_ptr<Impl> impl_;
 };
 
+// A folder of new files that becomes an output only when something names it (a grid set's generation folder, named
+// by its manifest): created here, and removed with the files in it by the destructor unless keep() was called, and
+// by the SIGINT/SIGTERM/SIGHUP handler of OutputFile while it is registered. Holds files only, no subfolders.
+// @throw OutputError "PATH: cannot create the folder: REASON" from the constructor when `create` and mkdir fails
+// (EEXIST included: the folder must be new, so that nothing in it belongs to anyone else).
+class TemporaryFolder {
+ public:
+  // `create`: make the folder (it must not exist). Otherwise it was made by another process (an MPI rank) and is
+  // only registered for removal on a signal; the destructor then leaves it to its maker.
+  TemporaryFolder(const std::string& path, bool create);
+  ~TemporaryFolder();
+  TemporaryFolder(const TemporaryFolder&) = delete;
+  TemporaryFolder& operator=(const TemporaryFolder&) = delete;
+
+  // The folder stays: it is no longer removed on destruction or signal.
+  void keep();
+  // Removes the folder and its files now (the files of an abandoned output), and unregisters it.
+  void discard();
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  int slot_ = -1;
+  bool owner_ = false;
+};
+
 // Writes `bytes` to `path` through an OutputFile (see above).
 // @throw OutputError when the output cannot be written; the old output is then untouched.
 void writeFileAtomically(const std::string& path, std::string_view bytes);

@@ -6,9 +6,12 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "vox/io/atomic_file.h"
 #include "vox/io/grid_file.h"
 #include "vox/voxelize/bricks.h"
 #include "vox/voxelize/fill.h"
@@ -51,18 +54,57 @@ struct GridSetManifest {
 };
 
 // ---- Writing ----
+// A set is replaced as a whole or not at all. Its files go into a generation folder of their own,
+// NAME.bricks/gHEX/ (NAME the manifest's file name without its last extension, HEX 16 random hex digits, the folder
+// created new), which the old set's manifest cannot name; the manifest is renamed into place last; only then are
+// the old set's files removed. A failure or signal before that leaves the old set whole and removes the new folder.
+// Two manifests in one folder never share a file, whatever their names.
 
-// The relative file names of a brick and of the scene file of the set at `setPath`: "NAME.bricks/b_X_Y_Z.vgrid"
-// and "NAME.bricks/scene.vgrid" (NAME the manifest's file name without its last extension).
-std::string brickFileName(const std::string& setPath, const std::array<uint32_t, 3>& index);
-std::string sceneFileName(const std::string& setPath);
-// Creates the folder the bricks of `setPath` go into (NAME.bricks beside it). Throws OutputError.
-void makeBrickFolder(const std::string& setPath);
+// The relative names of a brick and of the scene file inside a set's generation folder `folder` (relative to the
+// manifest's folder): "FOLDER/b_X_Y_Z.vgrid" and "FOLDER/scene.vgrid". brickFileName takes the folder from the set's
+// scene file.
+std::string brickFileName(const GridSetManifest& set, const std::array<uint32_t, 3>& index);
+std::string sceneFileName(const std::string& folder);
+
+// Refuses, before any work, an output that cannot be a set's manifest: a name holding control bytes (readers refuse
+// them), an existing node that is not a regular file (a device would send the bricks to /dev), or a name that is
+// its own brick folder ("foo.bricks": the folder foo.bricks/ would take the manifest's place). Throws OutputError.
+void checkGridSetOutput(const std::string& setPath);
+
+// The set at `path` that a new output there will replace, when `path` holds a readable manifest.
+std::optional<GridSetManifest> previousGridSet(const std::string& path);
+
+// Removes the files of `old`, a set whose manifest at `setPath` has been replaced: only names of the set layout
+// (NAME.bricks/scene.vgrid, NAME.bricks/b_X_Y_Z.vgrid, and the same inside NAME.bricks/gHEX/) whose size and header
+// checksum are the ones `old` lists, then their generation folders when empty. Never throws: what cannot be
+// removed stays.
+void removeGridSetFiles(const std::string& setPath, const GridSetManifest& old);
+
+// One set being written: the output checked, the set it replaces read, the generation folder made (or, on MPI
+// ranks other than the writer, the folder that rank made registered for removal on a signal). Destroying it before
+// commit() removes the generation folder (writer only), so an exception anywhere leaves the old set as it was.
+// @throw OutputError when the output is refused (checkGridSetOutput) or the folders cannot be made.
+class GridSetOutput {
+ public:
+  // `folder` empty: this process makes the generation folder. Otherwise the folder another rank made (folder()).
+  explicit GridSetOutput(const std::string& setPath, const std::string& folder = {});
+  // The generation folder, relative to the manifest's folder ("NAME.bricks/gHEX").
+  const std::string& folder() const { return folder_; }
+  // Writes `manifest` over the output (writeGridSetManifest), then removes the files of the set it replaced.
+  void commit(const GridSetManifest& manifest);
+
+ private:
+  std::string setPath_;
+  std::string folder_;
+  std::optional<GridSetManifest> previous_;
+  std::unique_ptr<TemporaryFolder> files_;
+};
 
 // Encodes the scene file of `scene` and the planned grid `plan` (bounds, dims, method, outsidePrims; its cells are
-// ignored) and, when `write`, writes it beside the manifest. Every process computes the same name, size and
-// checksum, so ranks that do not write it can still reference it. Throws OutputError.
-GridSetScene writeGridSetScene(const std::string& setPath, const Scene& scene, const Grid& plan, bool write = true);
+// ignored) and, when `write`, writes it into the generation folder `folder` (GridSetOutput::folder()). Every process
+// computes the same name, size and checksum, so ranks that do not write it can still reference it. Throws OutputError.
+GridSetScene writeGridSetScene(const std::string& setPath, const std::string& folder, const Scene& scene,
+                               const Grid& plan, bool write = true);
 
 // Writes brick `index` of `set` (plan, bricks and scene file taken from it) holding the cells and solid runs of
 // `cells` (whole-grid keys, all inside the brick). Returns its entry. Throws OutputError.
@@ -86,11 +128,13 @@ BrickEntry writeBrick(const std::string& setPath, const GridSetManifest& set, co
 FillReport fillGridSet(const std::string& setPath, GridSetManifest& set, const Scene& scene,
                        const FillOptions& options);
 
-// Writes the manifest (atomically: a failure leaves no manifest). Entries without cells are left out.
+// Writes the manifest (atomically: a failure leaves the old one). Entries without cells are left out. Prefer
+// GridSetOutput::commit, which also removes the replaced set's files.
 void writeGridSetManifest(const std::string& setPath, const GridSetManifest& manifest);
 
-// The whole job on one process: plan, scene file, candidates, each brick voxelized and written before the next
-// starts, the fill when `fill` is given (its report in `fillReport`), then the manifest. `progress` (may be empty)
+// The whole job on one process: the output checked, plan, scene file, candidates, each brick voxelized and written
+// before the next starts, the fill when `fill` is given (its report in `fillReport`), then the manifest, through a
+// GridSetOutput (a failure or cancel leaves the old set whole). `progress` (may be empty)
 // gets the fraction of bricks done. Returns the manifest written.
 GridSetManifest writeGridSet(const std::string& setPath, const Scene& scene, const VoxelizeOptions& options,
                              const std::array<uint32_t, 3>& bricks, VoxelizeStats* stats = nullptr,

@@ -173,5 +173,6 @@ void bindSave(GridClass& grid);
 void bindRays(GridClass& grid);
 void bindRender(py::module_& m);
 void bindMesh(GridClass& grid);
+void bindBench(py::module_& m);
 
 }  // namespace voxpy

@@ -12,4 +12,5 @@ PYBIND11_MODULE(_libvox, m) {
   voxpy::bindRays(grid);
   voxpy::bindVoxelize(m);
   voxpy::bindRender(m);
+  voxpy::bindBench(m);
 }

@@ -212,7 +212,6 @@ py::object voxelizeBatch(const py::iterable& sources, const py::object& resoluti
   Interrupt interrupt(progressCallable(progress, "voxelizing"));
   std::atomic<size_t> done{0};
   runLong(interrupt, nThreads, [&] {
-    if (cells) std::fill(cells, cells + cube * srcs.size(), false);
     tbb::parallel_for(size_t(0), srcs.size(), [&](size_t b) {
       if (interrupt.cancelled()) return;
       Source& src = srcs[b];
@@ -236,6 +235,7 @@ py::object voxelizeBatch(const py::iterable& sources, const py::object& resoluti
       });
       if (cells) {
         bool* p = cells + cube * b;
+        std::fill(p, p + cube, false);  // here, not before the loop: the first touch of the pages in parallel too
         vox::forEachVoxelRow(g, [&](const vox::VoxelRow& row) {
           for (uint32_t n = 0; n < row.count; ++n) p[(uint64_t(row.i0 + n) * r + row.j) * r + row.k] = true;
         });

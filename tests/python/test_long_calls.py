@@ -128,9 +128,12 @@ def test_batch_threads_scale():
     libvox.voxelize_batch(meshes[:10], 64)
     times = {}
     for threads in (1, 2):
-        start = time.perf_counter()
-        out = libvox.voxelize_batch(meshes, 64, threads=threads)
-        times[threads] = time.perf_counter() - start
+        best = float("inf")
+        for _ in range(3):  # the best of three: other jobs share the cores
+            start = time.perf_counter()
+            out = libvox.voxelize_batch(meshes, 64, threads=threads)
+            best = min(best, time.perf_counter() - start)
+        times[threads] = best
         times[f"sum{threads}"] = int(out.sum())
     assert times["sum1"] == times["sum2"]
     # 2 cores shared with other jobs in CI: a clear gain, not the bench's full 1.7x.

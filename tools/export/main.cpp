@@ -3,6 +3,8 @@
 
 #include <chrono>
 #include <filesystem>
+#include <new>
+#include <stdexcept>
 
 #include "../common/cli.h"
 #include "vox/io/atomic_file.h"
@@ -27,6 +29,36 @@ struct Options {
 
 double secondsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// Runs an export step on a grid that has been read: the writers and mesh builders see a grid in memory and a stream,
+// so their messages ("vox: ... voxels need ...", "grid: cell key ...") name no file; here each gets the grid's name
+// in front, as every read error has (a message that already names it, such as a set's, is kept). Output errors name
+// the output already. An allocation that failed anyway (std::bad_alloc, or std::length_error from a size beyond
+// what a vector can hold) becomes the same kind of message, exit 2 as a LimitError.
+template <typename F>
+auto namingGrid(const Options& opt, F&& step) -> decltype(step()) {
+  using namespace vox;
+  const auto named = [&](const char* what) {
+    const std::string message = what;
+    return message.find(opt.grid) != std::string::npos ? message : opt.grid + ": " + message;
+  };
+  try {
+    return step();
+  } catch (const OutputError&) {
+    throw;
+  } catch (const UsageError&) {
+    throw;
+  } catch (const LimitError& e) {
+    throw LimitError(named(e.what()));
+  } catch (const Error& e) {
+    throw InputError(named(e.what()));
+  } catch (const std::bad_alloc&) {
+    fail<LimitError>(opt.grid, ": ", opt.output,
+                     ": out of memory (the export needed more than estimated; try a smaller grid)");
+  } catch (const std::length_error& e) {
+    fail<LimitError>(opt.grid, ": ", opt.output, ": a size beyond what memory can hold (", e.what(), ")");
+  }
 }
 
 // Voxel formats (.binvox, .vox, .vdb): the cells themselves, not a mesh; --faces and --ascii do not apply.
@@ -57,13 +89,14 @@ int runVoxelFormat(const Options& opt, vox::VoxelFormat format) {
   bar.update(0.1);
   std::vector<Rgb8> colors;
   if (!layered && format == VoxelFormat::MagicaVoxel && color != ColorMode::None)
-    colors = occupiedCellColors(file.grid, file.scene, color);
+    colors = namingGrid(opt, [&] { return occupiedCellColors(file.grid, file.scene, color); });
   bar.update(0.2);
   const auto writeStart = std::chrono::steady_clock::now();
   const auto progress = [&](double f) { bar.update(0.2 + 0.8 * f); };
-  const VoxelFileReport report = layered
-                                     ? writeGridSetVoxelFile(opt.output, format, opt.grid, set, file, color, progress)
-                                     : writeVoxelFile(opt.output, format, file.grid, colors, progress);
+  const VoxelFileReport report = namingGrid(opt, [&] {
+    return layered ? writeGridSetVoxelFile(opt.output, format, opt.grid, set, file, color, progress)
+                   : writeVoxelFile(opt.output, format, file.grid, colors, progress);
+  });
   const double writeSeconds = secondsSince(writeStart);
   bar.finish();
   if (format == VoxelFormat::Binvox && report.binvoxShiftVoxels > 1e-9 && !opt.common.quiet)
@@ -111,11 +144,11 @@ int run(const Options& opt) {
   bar.update(0.2);
   VoxelMeshStats stats;
   const auto buildStart = std::chrono::steady_clock::now();
-  const VoxelMesh mesh = buildVoxelMesh(file.grid, file.scene, faces, color, &stats);
+  const VoxelMesh mesh = namingGrid(opt, [&] { return buildVoxelMesh(file.grid, file.scene, faces, color, &stats); });
   const double buildSeconds = secondsSince(buildStart);
   bar.update(0.6);
   const auto writeStart = std::chrono::steady_clock::now();
-  writeVoxelMesh(opt.output, mesh, !opt.ascii);
+  namingGrid(opt, [&] { writeVoxelMesh(opt.output, mesh, !opt.ascii); });
   const double writeSeconds = secondsSince(writeStart);
   bar.finish();
 
@@ -124,7 +157,9 @@ int run(const Options& opt) {
     size_t exposedFaces = stats.exposedFaces, mergedFaces = mesh.faceCount();
     if (faces != FaceMode::Merged) {
       VoxelMeshStats mergedStats;
-      mergedFaces = buildVoxelMesh(file.grid, file.scene, FaceMode::Merged, color, &mergedStats).faceCount();
+      mergedFaces = namingGrid(opt, [&] {
+        return buildVoxelMesh(file.grid, file.scene, FaceMode::Merged, color, &mergedStats).faceCount();
+      });
       exposedFaces = mergedStats.exposedFaces;
     }
     std::error_code sizeError;

@@ -14,9 +14,10 @@
 #include <string>
 #include <vector>
 
+#include "export/export_budget.h"
+#include "vox/core/checked_math.h"
 #include "vox/core/error.h"
 #include "vox/export/voxel_runs.h"
-#include "vox/io/input_file.h"
 
 namespace vox {
 
@@ -41,6 +42,16 @@ class RunEncoder {
 
  private:
   void emit() {
+    // Whole pairs of 255 in blocks: an empty or full cube of 4096^3 is 2^28 of them, which one push per pair made
+    // seconds of the export.
+    const std::string block = std::string(1, char(value_ ? 1 : 0)) + char(255);
+    while (count_ >= 255 * kBlockPairs) {
+      if (pairs_.size() != 2 * kBlockPairs || pairs_[0] != block[0])
+        for (pairs_.clear(); pairs_.size() < 2 * kBlockPairs;) pairs_ += block;
+      buffer_ += pairs_;
+      count_ -= 255 * kBlockPairs;
+      if (buffer_.size() >= (1u << 20)) flushBuffer();
+    }
     while (count_ > 0) {
       const uint64_t n = std::min<uint64_t>(count_, 255);
       buffer_.push_back(char(value_ ? 1 : 0));
@@ -53,14 +64,17 @@ class RunEncoder {
     out_.write(buffer_.data(), std::streamsize(buffer_.size()));
     buffer_.clear();
   }
+  static constexpr uint64_t kBlockPairs = 4096;
   std::ostream& out_;
   std::string buffer_;
+  std::string pairs_;  // kBlockPairs pairs (value, 255) of the last value emitted in blocks
   bool value_ = false;
   uint64_t count_ = 0;
 };
 
-// Encodes `bits` (the first `nbits` of them) in order.
-void encodePlane(const std::vector<uint64_t>& words, uint64_t nbits, RunEncoder& enc) {
+// Encodes `bits` (the first `nbits` of them, `setBits` of them set) in order.
+void encodePlane(const std::vector<uint64_t>& words, uint64_t nbits, uint64_t setBits, RunEncoder& enc) {
+  if (setBits == 0 || setBits == nbits) return enc.add(setBits != 0, nbits);  // without reading D^2 / 64 words
   for (size_t w = 0; w < words.size(); ++w) {
     const unsigned valid = unsigned(std::min<uint64_t>(64, nbits - 64 * w));
     uint64_t word = words[w];
@@ -119,8 +133,9 @@ BinvoxLayout writeBinvox(std::ostream& out, const Grid& plan, const VoxelRowSour
     ++eventStart[r.i0 + r.count + 1];
   });
   for (size_t x = 1; x < eventStart.size(); ++x) eventStart[x] += eventStart[x - 1];
-  checkMemory(double(eventStart.back()) * sizeof(uint32_t) + double(d + 1) * sizeof(uint64_t) + double(planeBits) / 8,
-              "binvox", "run events and one plane");
+  requireMemory(
+      saturatingSum({saturatingMul(eventStart.back(), sizeof(uint32_t)), (d + 1) * sizeof(uint64_t), planeBits / 8}),
+      "binvox", "run events and one plane");
   std::vector<uint32_t> events(eventStart.back());
   {
     std::vector<uint64_t> fill(eventStart.begin(), eventStart.end() - 1);
@@ -138,10 +153,15 @@ BinvoxLayout writeBinvox(std::ostream& out, const Grid& plan, const VoxelRowSour
   out << header;
   RunEncoder enc(out);
   std::vector<uint64_t> plane((planeBits + 63) / 64, 0);
+  uint64_t setBits = 0;
   for (uint64_t x = 0; x < d; ++x) {
-    for (uint64_t e = eventStart[x]; e < eventStart[x + 1]; ++e)
-      plane[events[e] / 64] ^= uint64_t(1) << (events[e] % 64);
-    encodePlane(plane, planeBits, enc);
+    for (uint64_t e = eventStart[x]; e < eventStart[x + 1]; ++e) {
+      uint64_t& word = plane[events[e] / 64];
+      const uint64_t bit = uint64_t(1) << (events[e] % 64);
+      word ^= bit;
+      setBits = word & bit ? setBits + 1 : setBits - 1;
+    }
+    encodePlane(plane, planeBits, setBits, enc);
     if (progress && x % 64 == 0) progress(double(x) / double(d));
   }
   enc.finish();

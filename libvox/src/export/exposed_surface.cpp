@@ -27,7 +27,9 @@
 #include <numeric>
 #include <unordered_map>
 
+#include "export/export_budget.h"
 #include "export/voxel_surface.h"
+#include "vox/core/checked_math.h"
 
 namespace vox::voxel_surface {
 
@@ -160,6 +162,8 @@ constexpr int kPadLo = 2, kPadHi = 2;           // cells copied around a brick: 
 constexpr int kPad = kBrick + kPadLo + kPadHi;  // 12
 constexpr int kKeyBits = 21;
 constexpr uint64_t kKeyMask = (uint64_t(1) << kKeyBits) - 1;
+// An entry of std::unordered_map<uint64_t, uint32_t> with its node and bucket (reserved at twice the entries).
+constexpr uint64_t kHashEntryBytes = 48;
 
 uint64_t brickKey(uint64_t bx, uint64_t by, uint64_t bz) { return bx | (by << kKeyBits) | (bz << (2 * kKeyBits)); }
 std::array<int64_t, 3> brickCoords(uint64_t key) {
@@ -201,7 +205,14 @@ BrickSet buildBricks(const Voxels& vox, const std::array<uint32_t, 3>& dims) {
   tbb::parallel_sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
     return a.brick != b.brick ? a.brick < b.brick : a.local < b.local;
   });
+  // The voxel list's estimate (voxel_mesh.cpp) covers the entries and colours; bricks are per 8^3 block touched, up
+  // to one per voxel when they are scattered, so they are counted and checked before they are made.
+  uint64_t nBricks = 0;
+  for (size_t v = 0; v < entries.size(); ++v) nBricks += v == 0 || entries[v].brick != entries[v - 1].brick;
+  requireMemory(saturatingMul(nBricks, sizeof(Brick) + kHashEntryBytes), "voxel mesh",
+                std::to_string(nBricks) + " bricks of 8^3 cells");
   BrickSet set;
+  set.bricks.reserve(nBricks);
   set.colors.resize(entries.size());
   for (size_t v = 0; v < entries.size(); ++v) {
     if (set.bricks.empty() || set.bricks.back().key != entries[v].brick) {
@@ -304,6 +315,8 @@ struct WorkBricks {
 };
 
 WorkBricks workBricks(const BrickSet& set) {
+  requireMemory(saturatingMul(set.bricks.size(), 8 * (sizeof(uint64_t) + kHashEntryBytes)), "voxel mesh",
+                "the lattice bricks around " + std::to_string(set.bricks.size()) + " bricks");
   WorkBricks work;
   work.keys.reserve(set.bricks.size() * 8);
   for (const Brick& b : set.bricks) {
@@ -332,6 +345,8 @@ struct VertexNumbering {
 
 VertexNumbering numberVertices(const BrickSet& set, const WorkBricks& work, const PointTables& tables) {
   const size_t nWork = work.keys.size();
+  requireMemory(saturatingMul(nWork, sizeof(std::array<uint16_t, 512>) + sizeof(uint64_t)), "voxel mesh",
+                "the vertex numbers of " + std::to_string(nWork) + " lattice bricks");
   VertexNumbering num;
   num.firstLocal.resize(nWork);
   num.base.assign(nWork + 1, 0);
@@ -467,6 +482,8 @@ ExposedSurface buildExposed(const Voxels& vox, const Lattice& lat) {
   const size_t nWork = work.keys.size();
   const VertexNumbering num = numberVertices(set, work, tables);
 
+  requireMemory(saturatingMul(num.base[nWork], sizeof(Vec3) + 1), "voxel mesh",
+                std::to_string(num.base[nWork]) + " vertices");
   ExposedSurface out;
   out.positions.resize(num.base[nWork]);
   out.split.resize(num.base[nWork]);

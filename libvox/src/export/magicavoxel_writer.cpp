@@ -15,9 +15,10 @@
 #include <string>
 #include <unordered_map>
 
+#include "export/export_budget.h"
+#include "vox/core/checked_math.h"
 #include "vox/core/error.h"
 #include "vox/export/voxel_runs.h"
-#include "vox/io/input_file.h"
 
 namespace vox {
 
@@ -98,10 +99,32 @@ struct Census {
   uint64_t solidOnly = 0;  // voxels without a cell colour
 };
 
+// The fewest bytes a file with `voxels` voxels in `models` models can take: 4 per voxel (XYZI), and per model its
+// SIZE (24) and XYZI (16) chunk headers, its nTRN (55 with the shortest "_t") and nSHP (32) chunks and its id in the
+// nGRP's child list (4). Refusing on this bound, before a row is visited, keeps the census (one map entry per model)
+// and the rows it visits bounded by the format's 2^31 - 1 bytes.
+constexpr uint64_t kMinModelBytes = 24 + 16 + 55 + 32 + 4;
+// A Tile in the census's std::map: the value and the map node's pointers, colour and allocator header.
+constexpr uint64_t kCensusTileBytes = sizeof(std::pair<const uint64_t, Tile>) + 48;
+
+uint64_t minFileBytes(uint64_t voxels, uint64_t models) {
+  return saturatingSum({saturatingMul(4, voxels), saturatingMul(kMinModelBytes, models)});
+}
+
+[[noreturn]] void refuseFileSize(uint64_t voxels, uint64_t bytes) {
+  fail<LimitError>("vox: ", describeCount(voxels), " voxels need ",
+                   bytes == UINT64_MAX ? "more than 2^64" : "at least " + describeCount(bytes),
+                   " bytes, more than the 2^31 - 1 that the format's int32 chunk sizes allow (export a coarser grid "
+                   "or several bricks)");
+}
+
 Census takeCensus(const Grid& plan, const Tiling& tiling, const ColoredPieceSource& pieces, Rgb8 solidColor) {
   Census census;
   uint64_t colored = 0;
-  const auto weigh = [&](const Grid&, std::span<const Rgb8> colors) {
+  uint64_t tallied = 0;  // voxels of the pieces reached so far, counted from their runs before their rows
+  const auto weigh = [&](const Grid& piece, std::span<const Rgb8> colors) {
+    tallied = saturatingAdd(tallied, tallyVoxels(piece).voxels);
+    if (minFileBytes(tallied, 0) > uint64_t(INT32_MAX)) refuseFileSize(tallied, minFileBytes(tallied, 0));
     for (const Rgb8& c : colors) ++census.weights[pack(c)];
     colored += colors.size();
   };
@@ -110,6 +133,9 @@ Census takeCensus(const Grid& plan, const Tiling& tiling, const ColoredPieceSour
     splitRow(tiling, r, [&](uint64_t key, uint32_t i, uint32_t n) {
       Tile& t = census.tiles[key];
       if (t.voxels == 0) {
+        const uint64_t models = census.tiles.size();
+        if (minFileBytes(tallied, models) > uint64_t(INT32_MAX)) refuseFileSize(tallied, minFileBytes(tallied, models));
+        if (models % 4096 == 0) requireMemory(models * kCensusTileBytes, "vox", "the models' census");
         const std::array<uint32_t, 3> cell{i, r.j, r.k};
         for (int a = 0; a < 3; ++a) {
           t.origin[a] = cell[a] / kVoxModelSide * kVoxModelSide;
@@ -343,7 +369,7 @@ MagicaVoxelStats writeMagicaVoxelPieces(std::ostream& out, const Grid& plan, con
     fail<LimitError>("vox: ", stats.voxels, " voxels need ", children,
                      " bytes, more than the 2^31 - 1 that the "
                      "format's int32 chunk sizes allow (export a coarser grid or several bricks)");
-  checkMemory(double(slabMax) * 4, "vox", "one 256-cell slab of voxels");
+  requireMemory(saturatingMul(slabMax, 4), "vox", "one 256-cell slab of voxels");
 
   const PaletteMap palette = buildPalette(census.weights);
   stats.gridColors = uint32_t(census.weights.size());

@@ -14,9 +14,11 @@
 
 #include "vox/export/cell_color.h"
 #include "vox/export/colormap.h"
+#include "export/export_budget.h"
 #include "export/voxel_surface.h"
+#include "vox/core/checked_math.h"
 #include "vox/core/error.h"
-#include "vox/io/input_file.h"
+#include "vox/export/voxel_runs.h"
 
 namespace vox {
 
@@ -100,29 +102,31 @@ std::vector<uint32_t> occupiedColors(const Grid& grid, const Scene& scene, Color
   return occColor;
 }
 
-Voxels gatherVoxels(const Grid& grid, const Scene& scene, ColorMode mode) {
-  const uint64_t cellCount = grid.cellCount();
+// Bytes per voxel at the peak of each face mode, for the estimate made before the voxel list exists. Exposed and
+// Merged: the voxel list (key 8, colour 4) alive while buildBricks holds its entries (brick key 8, local index 4,
+// colour 4) and the bricks' colours (4); what follows is per brick, vertex or square and checked where it is
+// allocated. All: the voxel list and the cubes (8 positions of 24 bytes, 36 vertex ids and 12 face starts of 4, 12
+// colours of 3).
+constexpr uint64_t kSurfaceBytesPerVoxel = 12 + 16 + 4;
+constexpr uint64_t kCubeBytesPerVoxel = 12 + 8 * sizeof(Vec3) + 36 * 4 + 12 * 4 + 12 * 3;
+
+Voxels gatherVoxels(const Grid& grid, const Scene& scene, ColorMode mode, uint64_t bytesPerVoxel) {
   const size_t nOcc = grid.cellKeys.size();
   if (grid.cellStart.size() != nOcc + 1 || grid.cellStart.back() > grid.primIds.size())
     fail<InputError>("grid: inconsistent cell table (", nOcc, " cells, ", grid.cellStart.size(), " offsets)");
-  auto checkSorted = [&](const std::vector<uint64_t>& keys, const char* what) {
-    for (size_t i = 0; i < keys.size(); ++i) {
-      if (keys[i] >= cellCount) fail<InputError>("grid: ", what, " key ", keys[i], " outside the grid");
-      if (i > 0 && keys[i] <= keys[i - 1]) fail<InputError>("grid: ", what, " keys not sorted at index ", i);
-    }
-  };
-  checkSorted(grid.cellKeys, "cell");
-  checkSolidRuns(grid.solidRuns, cellCount, "grid");
-  const uint64_t solidCount = grid.solidCount();
-  checkMemory((nOcc + solidCount) * 12, "grid", "the voxel list");
+  // Counted from the keys and runs (which this checks) without expanding them, so that a grid of 2^63 solid cells
+  // is refused at once instead of after its list has grown to the memory's end.
+  const uint64_t voxels = tallyVoxels(grid).voxels;
+  requireMemory(saturatingMul(voxels, bytesPerVoxel), "voxel mesh",
+                "a list of " + describeCount(voxels) + " voxels at " + std::to_string(bytesPerVoxel) + " bytes each");
 
   const std::vector<uint32_t> occColor = occupiedColors(grid, scene, mode);
 
   // Merge occupied keys and solid runs; a cell in both is drawn once, with its occupied colour.
   const uint32_t solid = mode == ColorMode::None ? kNoColor : packColor(kSolidCellColor);
   Voxels v;
-  v.keys.reserve(nOcc + solidCount);
-  v.colors.reserve(nOcc + solidCount);
+  v.keys.reserve(voxels);
+  v.colors.reserve(voxels);
   size_t a = 0;
   for (const CellRun& run : grid.solidRuns) {
     for (uint64_t key = run.first; key < run.first + run.count; ++key) {
@@ -176,7 +180,8 @@ VoxelMesh buildCubes(const Voxels& vox, const Lattice& lat, bool colored) {
 
 VoxelMesh buildVoxelMesh(const Grid& grid, const Scene& scene, FaceMode faces, ColorMode color, VoxelMeshStats* stats) {
   const auto start = std::chrono::steady_clock::now();
-  const Voxels vox = gatherVoxels(grid, scene, color);
+  const Voxels vox =
+      gatherVoxels(grid, scene, color, faces == FaceMode::All ? kCubeBytesPerVoxel : kSurfaceBytesPerVoxel);
   const Lattice lat{grid.bounds, grid.dims};
   const bool colored = color != ColorMode::None;
   VoxelMesh mesh;

@@ -9,6 +9,8 @@ namespace vox {
 
 namespace {
 
+constexpr uint32_t kMaxDim = uint32_t(1) << 21;
+
 // Cuts the key range [first, end) at row ends and reports each piece.
 void emitRows(const Grid& grid, uint64_t first, uint64_t end, const std::function<void(const VoxelRow&)>& visit) {
   const uint64_t nx = grid.dims[0];
@@ -28,7 +30,11 @@ void emitRows(const Grid& grid, uint64_t first, uint64_t end, const std::functio
 
 }  // namespace
 
-void forEachVoxelRow(const Grid& grid, const std::function<void(const VoxelRow&)>& visit) {
+void forEachVoxelInterval(const Grid& grid, const std::function<void(uint64_t first, uint64_t end)>& visit) {
+  // Every grid libvox makes or reads has 1..2^21 cells per axis (docs/grid-format.md), so keys stay below 2^63 and
+  // cellCount() cannot wrap; a grid built in memory by other means is held to the same.
+  for (uint32_t n : grid.dims)
+    if (n == 0 || n > kMaxDim) fail<InputError>("grid: dimension ", n, " outside 1..2^21");
   const uint64_t cells = grid.cellCount();
   checkSolidRuns(grid.solidRuns, cells, "grid");
   const std::vector<uint64_t>& keys = grid.cellKeys;
@@ -52,22 +58,33 @@ void forEachVoxelRow(const Grid& grid, const std::function<void(const VoxelRow&)
       end = std::max(end, stop);
       continue;
     }
-    if (open) emitRows(grid, first, end, visit);
+    if (open) visit(first, end);
     first = start;
     end = stop;
     open = true;
   }
-  if (open) emitRows(grid, first, end, visit);
+  if (open) visit(first, end);
+}
+
+void forEachVoxelRow(const Grid& grid, const std::function<void(const VoxelRow&)>& visit) {
+  forEachVoxelInterval(grid, [&](uint64_t first, uint64_t end) { emitRows(grid, first, end, visit); });
 }
 
 VoxelRowSource voxelRows(const Grid& grid) {
   return [&grid](const std::function<void(const VoxelRow&)>& visit) { forEachVoxelRow(grid, visit); };
 }
 
-uint64_t countVoxels(const Grid& grid) {
-  uint64_t n = 0;
-  forEachVoxelRow(grid, [&](const VoxelRow& r) { n += r.count; });
-  return n;
+VoxelTally tallyVoxels(const Grid& grid) {
+  // Keys are below cellCount() <= 2^63 (dims at most 2^21), so neither sum can wrap.
+  const uint64_t nx = grid.dims[0];
+  VoxelTally t;
+  forEachVoxelInterval(grid, [&](uint64_t first, uint64_t end) {
+    t.voxels += end - first;
+    t.rows += (end - 1) / nx - first / nx + 1;
+  });
+  return t;
 }
+
+uint64_t countVoxels(const Grid& grid) { return tallyVoxels(grid).voxels; }
 
 }  // namespace vox

@@ -17,6 +17,11 @@ struct VoxelRow {
   uint32_t count = 0;  // >= 1; i0 + count <= dims[0]
 };
 
+// Calls visit(first, end) for the union of grid.cellKeys and grid.solidRuns as maximal ranges [first, end) of
+// consecutive keys, in increasing order (not cut at row ends, so a run over a billion rows is one call). Work is
+// O(occupied cells + solid runs), whatever the number of cells. Throws as forEachVoxelRow.
+void forEachVoxelInterval(const Grid& grid, const std::function<void(uint64_t first, uint64_t end)>& visit);
+
 // Calls visit(row) for the union of grid.cellKeys and grid.solidRuns, in increasing key order, as maximal runs of
 // consecutive keys cut at the ends of grid rows (so a run never leaves its (j, k) row). A cell that is both
 // occupied and solid is visited once.
@@ -31,7 +36,16 @@ using VoxelRowSource = std::function<void(const std::function<void(const VoxelRo
 // The rows of a grid in memory (forEachVoxelRow) as a source; `grid` must outlive it.
 VoxelRowSource voxelRows(const Grid& grid);
 
-// Number of distinct voxels (occupied or solid), counted from the runs. Same checks as forEachVoxelRow.
+// What the writers' estimates start from, counted from the intervals in O(occupied cells + solid runs) without
+// visiting a row: the distinct voxels (occupied or solid), and the rows forEachVoxelRow would visit.
+struct VoxelTally {
+  uint64_t voxels = 0;
+  uint64_t rows = 0;
+};
+// Same checks as forEachVoxelRow.
+VoxelTally tallyVoxels(const Grid& grid);
+
+// Number of distinct voxels (occupied or solid): tallyVoxels(grid).voxels.
 uint64_t countVoxels(const Grid& grid);
 
 }  // namespace vox

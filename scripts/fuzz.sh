@@ -10,7 +10,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 mkdir -p "$1"
 build=$(cd "$1" && pwd)
 seconds=$2
-targets=(course obj ply gltf glb grid)
+targets=(course obj ply gltf glb grid voxel_writers)
 
 # -O1 -gline-tables-only, as OSS-Fuzz builds: about half the compile time of -O2 -g, and reports keep file:line.
 CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVOX_FUZZ=ON \
@@ -26,7 +26,7 @@ export ASAN_OPTIONS=detect_leaks=1:abort_on_error=0
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 
 # Seeds: copies only, each at most the target's -max_len (libFuzzer would cut longer ones).
-declare -A max_len=([course]=8192 [obj]=8192 [ply]=8192 [gltf]=16384 [glb]=16384 [grid]=16384)
+declare -A max_len=([course]=8192 [obj]=8192 [ply]=8192 [gltf]=16384 [glb]=16384 [grid]=16384 [voxel_writers]=16384)
 seed() {  # seed TARGET FILE...
   local t=$1 f; shift
   for f in "$@"; do
@@ -138,7 +138,8 @@ made_set() {  # made_set SCENE NAME [voxelize options]; a seed less if the scene
   python3 - "$m/sets/$name.vgrid" "$m/${name}_set.vgrid" <<'PY'
 import glob, re, sys
 manifest, out = sys.argv[1], sys.argv[2]
-folder = manifest[:-len('.vgrid')] + '.bricks'
+# The set's files are in its generation folder NAME.bricks/gHEX/ (the only one: each seed set is written once).
+folder = glob.glob(manifest[:-len('.vgrid')] + '.bricks/g*')[0]
 def order(path):
     x, y, z = map(int, re.search(r'b_(\d+)_(\d+)_(\d+)\.vgrid$', path).groups())
     return (z, y, x)
@@ -161,6 +162,9 @@ seed ply "$m"/*.ply
 seed gltf "$m"/*.gltf
 seed glb "$m"/*.glb
 seed grid "$m"/*.vgrid
+# The voxel writers: the crafted grids of issue 23 and small ones (grid files and compact descriptions,
+# fuzz/voxel_writers_entry.h), and the grid files made above.
+seed voxel_writers "$root"/tests/data/fuzz/voxel_writers/* "$m"/all.vgrid "$m"/cube.vgrid "$m"/spheres.vgrid "$m"/fill.vgrid
 
 # As many targets at a time as there are cores; each writes its log, its exit code, and its findings as crash-*,
 # leak-*, timeout-* or oom-* files.

@@ -22,7 +22,10 @@ TEST(FuzzRegression, SavedInputsLoadOrAreRefused) {
   int replayed = 0;
   for (const auto& folder : std::filesystem::directory_iterator(root)) {
     const std::string target = folder.path().filename().string();
-    ASSERT_TRUE(target == "grid" || kSceneTargets.count(target)) << "unknown fuzz target folder " << folder.path();
+    ASSERT_TRUE(target == "grid" || target == "voxel_writers" || kSceneTargets.count(target))
+        << "unknown fuzz target folder " << folder.path();
+    // voxel_writers replays under its target's budget in voxel_formats_test.cpp (FuzzVoxelWriters).
+    if (target == "voxel_writers") continue;
     for (const auto& entry : std::filesystem::directory_iterator(folder.path())) {
       SCOPED_TRACE(entry.path().string());
       std::ifstream in(entry.path(), std::ios::binary);

@@ -8,12 +8,19 @@
 #include <openvdb/openvdb.h>
 
 #include <algorithm>
+#include <chrono>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <map>
+#include <optional>
 #include <random>
 #include <set>
 #include <sstream>
 
+#include "../fuzz/voxel_writers_entry.h"
 #include "test_util.h"
 #include "vox/core/error.h"
 #include "vox/export/binvox_writer.h"
@@ -466,6 +473,256 @@ TEST(VoxelFormat, ExtensionsAndFilesThroughTheOutputFile) {
     EXPECT_EQ(r.voxels, voxelSet(g).size());
   }
   EXPECT_THROW(writeVoxelFile(dir.file("missing/out.vox"), VoxelFormat::MagicaVoxel, g, {}), OutputError);
+}
+
+// ---- Crafted grids of few runs over many cells (issue 23): each writer answers or refuses at once, in time and
+// memory bounded by the runs, with the estimate in its message.
+
+// A grid of n^3 cells, every one of them solid, in one run (what a 906-byte grid file can hold at n = 2^21).
+Grid oneRunGrid(uint32_t n) {
+  Grid g;
+  g.dims = {n, n, n};
+  g.bounds = {{0, 0, 0}, {double(n), double(n), double(n)}};
+  g.solidRuns.push_back({0, g.cellCount()});
+  return g;
+}
+
+// VOX_MEMORY_LIMIT_MB for the test's scope, so that what fits does not depend on the machine.
+class ScopedBudget {
+ public:
+  explicit ScopedBudget(const char* megabytes) {
+    if (const char* old = std::getenv("VOX_MEMORY_LIMIT_MB")) old_ = old;
+    ::setenv("VOX_MEMORY_LIMIT_MB", megabytes, 1);
+  }
+  ~ScopedBudget() {
+    if (old_)
+      ::setenv("VOX_MEMORY_LIMIT_MB", old_->c_str(), 1);
+    else
+      ::unsetenv("VOX_MEMORY_LIMIT_MB");
+  }
+
+ private:
+  std::optional<std::string> old_;
+};
+
+// The message of the LimitError that `f` throws (failing the test when it throws nothing or something else), and
+// that it threw within `seconds`: a refusal comes from the runs' counts, before any row is visited.
+template <typename F>
+std::string limitMessage(F&& f, double seconds = 2.0) {
+  const auto start = std::chrono::steady_clock::now();
+  std::string message = "(nothing thrown)";
+  try {
+    f();
+  } catch (const LimitError& e) {
+    message = e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "not a LimitError: " << e.what();
+    return e.what();
+  }
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), seconds) << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  return message;
+}
+
+TEST(VoxelRuns, TallyCountsVoxelsAndRowsFromTheRunsAlone) {
+  for (const auto& dims : {std::array<uint32_t, 3>{37, 11, 9}, {5, 70, 23}, {1, 1, 1}, {130, 3, 129}}) {
+    Grid g = randomGrid(dims, dims[1], 200, 30);
+    g.solidRuns.push_back({g.cellCount() - 1, 1});  // the last cell, so that a run ends at the grid's end
+    if (g.solidRuns.size() > 1) {
+      const CellRun& prev = g.solidRuns[g.solidRuns.size() - 2];
+      if (prev.first + prev.count >= g.cellCount() - 1) g.solidRuns.pop_back();
+    }
+    uint64_t voxels = 0, rows = 0;
+    forEachVoxelRow(g, [&](const VoxelRow& r) {
+      voxels += r.count;
+      ++rows;
+    });
+    const VoxelTally t = tallyVoxels(g);
+    EXPECT_EQ(t.voxels, voxels);
+    EXPECT_EQ(t.rows, rows);
+    EXPECT_EQ(t.voxels, voxelSet(g).size());
+  }
+  // 2^63 cells in one run: 2^42 rows, counted without visiting one.
+  const auto start = std::chrono::steady_clock::now();
+  const VoxelTally t = tallyVoxels(oneRunGrid(1u << 21));
+  EXPECT_EQ(t.voxels, uint64_t(1) << 63);
+  EXPECT_EQ(t.rows, uint64_t(1) << 42);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 0.5);
+  Grid tooLarge = oneRunGrid(1);
+  tooLarge.dims = {1u << 22, 1, 1};  // past 2^21 on an axis: keys could reach 2^64
+  EXPECT_THROW(tallyVoxels(tooLarge), InputError);
+}
+
+// The 906-byte grid of issue 23 (dims 2^21, no occupied cell, one run over all 2^63 cells): .vox ran past 40 s
+// with memory growing 3 MB/s, .vdb past 40 s, the meshes said "vector::reserve" (the estimate (occupied + solid) * 12
+// wrapped to 0).
+TEST(HostileSolidRuns, TwoTo63SolidCellsAreRefusedAtOnceByEveryWriter) {
+  ScopedBudget budget("1024");
+  const Grid g = oneRunGrid(1u << 21);
+  std::ostringstream out;
+  EXPECT_NE(limitMessage([&] { writeBinvox(out, g); }).find("binvox: the grid's 2097152 cells"), std::string::npos);
+  EXPECT_NE(limitMessage([&] {
+              writeMagicaVoxel(out, g, {}, kSolidCellColor);
+            }).find("vox: 9223372036854775808 (2^63) voxels need more than 2^64 bytes"),
+            std::string::npos);
+  EXPECT_NE(limitMessage([&] { writeVdb(out, g); }).find("vdb: the voxels need 134217728 root tiles"),
+            std::string::npos);
+  for (FaceMode faces : {FaceMode::Exposed, FaceMode::Merged, FaceMode::All})
+    EXPECT_NE(limitMessage([&] {
+                buildVoxelMesh(g, Scene{}, faces, ColorMode::Count);
+              }).find("voxel mesh: a list of 9223372036854775808 (2^63) voxels at "),
+              std::string::npos);
+  EXPECT_TRUE(out.str().empty());
+}
+
+// 16384^3 in one run (2^42 cells): .vox took over 40 s (one row at a time). .vdb is 64 root tiles and no leaf.
+TEST(HostileSolidRuns, TwoTo42SolidCellsAreOneQuickVdbAndRefusedElsewhere) {
+  ScopedBudget budget("1024");
+  const Grid g = oneRunGrid(16384);
+  std::ostringstream out;
+  EXPECT_NE(limitMessage([&] { writeMagicaVoxel(out, g, {}, kSolidCellColor); })
+                .find("vox: 4398046511104 (2^42) voxels need at least 17592186044416 (2^44) bytes, more than the "
+                      "2^31 - 1"),
+            std::string::npos);
+  EXPECT_NE(limitMessage([&] {
+              buildVoxelMesh(g, Scene{}, FaceMode::Exposed, ColorMode::None);
+            }).find("4398046511104 (2^42) voxels"),
+            std::string::npos);
+  EXPECT_NE(limitMessage([&] { writeBinvox(out, g); }).find("16384 cells on its longest axis"), std::string::npos);
+  EXPECT_TRUE(out.str().empty());
+  const auto start = std::chrono::steady_clock::now();
+  const VdbStats s = writeVdb(out, g);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 2.0);
+  EXPECT_EQ(s.activeVoxels, uint64_t(1) << 42);
+  EXPECT_EQ(s.leafNodes, 0u);
+  std::istringstream in(out.str());
+  openvdb::initialize();
+  openvdb::io::Stream stream(in);
+  auto density = openvdb::gridPtrCast<openvdb::FloatGrid>(openvdb::findGridByName(*stream.getGrids(), "density"));
+  ASSERT_TRUE(density);
+  EXPECT_EQ(density->activeVoxelCount(), uint64_t(1) << 42);
+  EXPECT_EQ(density->tree().root().getTableSize(), 64u);  // 4^3 tiles of 4096^3
+  EXPECT_EQ(density->evalActiveVoxelBoundingBox(), openvdb::CoordBBox({0, 0, 0}, {16383, 16383, 16383}));
+}
+
+// All 1024^3 cells solid: the meshes took 14.6 GB and a minute before the budget refused them; now the voxel list's
+// estimate (32 bytes a voxel for the exposed surface) refuses them before anything is allocated. binvox and .vdb
+// answer quickly; .vox refuses (4 GiB of XYZI).
+TEST(HostileSolidRuns, AllSolid1024CubedIsRefusedByTheMeshesBeforeAllocating) {
+  ScopedBudget budget("1024");
+  const Grid g = oneRunGrid(1024);
+  for (FaceMode faces : {FaceMode::Exposed, FaceMode::Merged, FaceMode::All}) {
+    const std::string m = limitMessage([&] { buildVoxelMesh(g, Scene{}, faces, ColorMode::Count); });
+    EXPECT_NE(m.find("voxel mesh: a list of 1073741824 voxels at "), std::string::npos) << m;
+    EXPECT_NE(m.find("MiB, more than the 1024 MiB allowed"), std::string::npos) << m;
+  }
+  std::ostringstream vox;
+  EXPECT_NE(limitMessage([&] {
+              writeMagicaVoxel(vox, g, {}, kSolidCellColor);
+            }).find("vox: 1073741824 voxels need at least 4294967296 (2^32) bytes"),
+            std::string::npos);
+  std::ostringstream vdb;
+  const VdbStats s = writeVdb(vdb, g);
+  EXPECT_EQ(s.activeVoxels, uint64_t(1) << 30);
+  EXPECT_EQ(s.leafNodes, 0u);
+  // binvox: 2^30 set bits as pairs (1, 255) and a last (1, 2^30 mod 255).
+  std::ostringstream binvox;
+  writeBinvox(binvox, g);
+  const std::string bytes = binvox.str();
+  const size_t data = bytes.find("data\n") + 5;
+  const uint64_t pairs = ((uint64_t(1) << 30) + 254) / 255;
+  ASSERT_EQ(bytes.size() - data, 2 * pairs);
+  for (size_t p = 0; p < pairs; ++p) {
+    ASSERT_EQ(bytes[data + 2 * p], 1);
+    ASSERT_EQ(uint8_t(bytes[data + 2 * p + 1]), p + 1 < pairs ? 255 : (uint64_t(1) << 30) % 255);
+  }
+}
+
+// The estimates that once wrapped: (occupied + solid) * 12 for 2^63 solid cells is 0 mod 2^64, so the check passed
+// and reserve(2^63) threw std::length_error "vector::reserve"; no writer lets such an error out.
+TEST(HostileSolidRuns, NoEstimateWrapsPastTheBudget) {
+  ScopedBudget budget("64");
+  Grid g = oneRunGrid(1u << 21);
+  g.solidRuns = {{0, (uint64_t(1) << 62) + (uint64_t(1) << 61)}, {uint64_t(7) << 60, uint64_t(1) << 60}};
+  g.cellKeys = {(uint64_t(1) << 62) + (uint64_t(1) << 61) + 5};
+  g.primIds = {0};
+  g.cellStart = {0, 1};
+  for (FaceMode faces : {FaceMode::Exposed, FaceMode::All})
+    EXPECT_NE(limitMessage([&] { buildVoxelMesh(g, Scene{}, faces, ColorMode::Count); }).find("voxel mesh: "),
+              std::string::npos);
+  std::ostringstream out;
+  limitMessage([&] { writeMagicaVoxel(out, g, {}, kSolidCellColor); });
+  limitMessage([&] { writeVdb(out, g); });
+}
+
+// Runs that cross rows and planes, in grids thin and thick: the .vdb builder takes whole rows as rectangles and
+// whole planes as boxes; the voxels read back by OpenVDB must be exactly the grid's.
+TEST(Vdb, RunsAcrossRowsAndPlanesKeepTheExactVoxels) {
+  std::mt19937_64 rng(23);
+  for (const auto& dims : {std::array<uint32_t, 3>{5, 4, 6}, {9, 17, 3}, {1, 7, 20}, {20, 1, 9}, {33, 9, 18}}) {
+    for (int trial = 0; trial < 6; ++trial) {
+      Grid g;
+      g.dims = dims;
+      g.bounds = {{0, 0, 0}, {1, 2, 3}};
+      const uint64_t cells = g.cellCount();
+      std::set<uint64_t> keys;
+      for (int i = 0; i < 10; ++i) keys.insert(rng() % cells);
+      g.cellKeys.assign(keys.begin(), keys.end());
+      for (size_t c = 0; c < g.cellKeys.size(); ++c) {
+        g.primIds.push_back(0);
+        g.cellStart.push_back(g.primIds.size());
+      }
+      for (uint64_t at = rng() % (dims[0] + 1); at < cells;) {
+        const uint64_t n = 1 + rng() % (trial % 2 ? cells : 2 * uint64_t(dims[0]) * dims[1]);
+        g.solidRuns.push_back({at, std::min(n, cells - at)});
+        at += n + 1 + rng() % (2 * dims[0]);
+      }
+      SCOPED_TRACE(::testing::Message() << dims[0] << "x" << dims[1] << "x" << dims[2] << " trial " << trial);
+      std::ostringstream out;
+      const VdbStats s = writeVdb(out, g);
+      std::istringstream in(out.str());
+      openvdb::initialize();
+      openvdb::io::Stream stream(in);
+      auto density = openvdb::gridPtrCast<openvdb::FloatGrid>(openvdb::findGridByName(*stream.getGrids(), "density"));
+      ASSERT_TRUE(density);
+      const std::set<Cell> cells2 = voxelSet(g);
+      EXPECT_EQ(s.activeVoxels, cells2.size());
+      std::set<Cell> got;
+      for (auto it = density->cbeginValueOn(); it; ++it) {
+        const openvdb::CoordBBox box = it.getBoundingBox();
+        for (auto c = box.begin(); c; ++c) got.insert({uint32_t((*c)[0]), uint32_t((*c)[1]), uint32_t((*c)[2])});
+      }
+      EXPECT_EQ(got, cells2);
+    }
+  }
+}
+
+// The .vdb builder's estimate counts the nodes a fill makes; a thin plane over a wide grid is refused before it is
+// filled (2^36 leaves), while the same cells as whole planes are tiles.
+TEST(Vdb, AThinWidePlaneIsRefusedBeforeItsLeavesAreMade) {
+  ScopedBudget budget("256");
+  Grid g = oneRunGrid(1u << 21);
+  g.solidRuns = {{1, (uint64_t(1) << 42) - 1}};  // plane k = 0 but for its first cell
+  std::ostringstream out;
+  EXPECT_NE(limitMessage([&] { writeVdb(out, g); }).find("vdb: the OpenVDB trees of the voxels needs about"),
+            std::string::npos);
+}
+
+// The fuzz target's inputs (tests/data/fuzz/voxel_writers/: the crafted grids above as seeds, and what fuzzing
+// saved) replay through its own code: each writer answers or refuses, never crashes, within the test's time.
+TEST(FuzzVoxelWriters, SavedInputsAnswerOrAreRefused) {
+  ScopedBudget budget(fuzz::kWriterBudgetMb);
+  const std::filesystem::path folder = std::filesystem::path(VOX_SOURCE_DIR) / "tests/data/fuzz/voxel_writers";
+  ASSERT_TRUE(std::filesystem::is_directory(folder)) << folder;
+  int replayed = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+    SCOPED_TRACE(entry.path().string());
+    std::ifstream in(entry.path(), std::ios::binary);
+    const std::string bytes{std::istreambuf_iterator<char>(in), {}};
+    EXPECT_NO_THROW(fuzz::runVoxelWritersInput(bytes));
+    ++replayed;
+  }
+  EXPECT_GE(replayed, 4);
 }
 
 }  // namespace

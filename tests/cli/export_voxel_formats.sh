@@ -105,5 +105,89 @@ elif [ -z "$sanitized" ]; then
   echo "note: blender missing, .vdb not imported"
 fi
 
+# Crafted grids of one solid run over many cells (issue 23), written here from docs/grid-format.md: every export
+# answers or refuses (exit 2, one line naming the grid and the estimate) within seconds, whatever the cells' count.
+# Before: 2^63 cells hung .vox and .vdb (over 40 s), the meshes said "vector::reserve"; 16384^3 hung .vox; 1024^3
+# all solid took the meshes 14.6 GB and a minute. The budget is fixed so that the refusals do not depend on the machine.
+$py - "$tmp" <<'PY'
+import struct, sys
+def checksum(p):
+    M = (1 << 64) - 1
+    h = 0x9E3779B97F4A7C15 ^ len(p)
+    n = len(p) // 8
+    for i in range(n):
+        h = ((h ^ struct.unpack_from('<Q', p, 8 * i)[0]) * 0x100000001B3) & M
+        h ^= h >> 29
+    if len(p) % 8:
+        h = ((h ^ int.from_bytes(p[8 * n:] + b'\0' * (8 - len(p) % 8), 'little')) * 0x100000001B3) & M
+        h ^= h >> 32
+    return h
+def grid(n):  # no primitive, no occupied cell, one solid run over all n^3 cells
+    p = struct.pack('<4Q', 0, 0, 0, 0) + b'\0' + struct.pack('<Q', 0) + struct.pack('<6d', 0, 0, 0, 0, 0, 0)
+    p += struct.pack('<6d', 0, 0, 0, n, n, n) + struct.pack('<3IB', n, n, n, 0)
+    p += struct.pack('<QQQQQ', 0, 1, 0, 0, 0) + struct.pack('<QQQ', 1, 0, n ** 3)
+    return b'VOXGRID\n' + struct.pack('<IIQQ', 2, 0, len(p), checksum(p)) + p
+for name, n in [('big', 1 << 21), ('g16k', 16384), ('g1024', 1024)]:
+    open(f'{sys.argv[1]}/{name}.vgrid', 'wb').write(grid(n))
+PY
+"$build/vox-info" "$tmp/big.vgrid" | grep -q "9223372036854775808 cells" || fail "big.vgrid is not the 2^63-cell grid"
+# crafted NAME EXT CODE PATTERN: exit CODE within 20 s (124: timed out); on exit 2 one stderr line naming the grid
+# and matching PATTERN.
+crafted() {
+  local name=$1 ext=$2 code=$3 pattern=${4:-} got start micros
+  start=${EPOCHREALTIME/./}
+  VOX_MEMORY_LIMIT_MB=1024 timeout 20 "$build/vox-export" "$tmp/$name.vgrid" -o "$tmp/$name.$ext" --quiet \
+    >"$tmp/stdout" 2>"$tmp/stderr"
+  got=$?
+  micros=$((${EPOCHREALTIME/./} - start))
+  echo "  $name.vgrid -> .$ext: exit $got in $((micros / 1000)) ms: $(head -c 200 "$tmp/stderr")"
+  [ "$got" = "$code" ] || { fail "$name.$ext: exit $got, expected $code (124: timed out)"; return; }
+  [ "$micros" -lt 10000000 ] || fail "$name.$ext: took ${micros} us"
+  if [ "$code" = 2 ]; then
+    [ "$(wc -l <"$tmp/stderr")" = 1 ] || fail "$name.$ext: not one line: $(cat "$tmp/stderr")"
+    grep -q "^vox-export: error: $tmp/$name.vgrid: $pattern" "$tmp/stderr" ||
+      fail "$name.$ext: message does not name the grid and match '$pattern': $(cat "$tmp/stderr")"
+    [ ! -e "$tmp/$name.$ext" ] || fail "$name.$ext: written although refused"
+  fi
+}
+crafted big binvox 2 "binvox: the grid's 2097152 cells on its longest axis exceed"
+crafted big vox 2 "vox: 9223372036854775808 (2^63) voxels need more than 2^64 bytes"
+crafted big vdb 2 "vdb: the voxels need 134217728 root tiles"
+crafted big ply 2 "voxel mesh: a list of 9223372036854775808 (2^63) voxels at 32 bytes each needs more than 2^64"
+crafted big stl 2 "voxel mesh: a list of 9223372036854775808 (2^63) voxels"
+crafted g16k vox 2 "vox: 4398046511104 (2^42) voxels need at least 17592186044416 (2^44) bytes"
+crafted g16k ply 2 "voxel mesh: a list of 4398046511104 (2^42) voxels"
+crafted g16k vdb 0
+crafted g1024 ply 2 "voxel mesh: a list of 1073741824 voxels at 32 bytes each needs about 32769 MiB, more than the 1024"
+crafted g1024 stl 2 "voxel mesh: a list of 1073741824 voxels"
+crafted g1024 obj 2 "voxel mesh: a list of 1073741824 voxels"
+crafted g1024 vox 2 "vox: 1073741824 voxels need at least"
+crafted g1024 vdb 0
+crafted g1024 binvox 0
+# The .vdb files hold every cell as root tiles (64 of 4096^3 at 16384^3, none of them leaves); binvox the whole cube.
+if [ "$has_vdb" = 1 ]; then
+  $py - "$tmp/g16k.vdb" "$tmp/g1024.vdb" <<'PY' || fail "crafted .vdb files do not hold every cell"
+import sys, pyopenvdb as vdb
+for path, n in zip(sys.argv[1:], (16384, 1024)):
+    d = vdb.read(path, 'density')
+    assert d.activeVoxelCount() == n ** 3, (path, d.activeVoxelCount())
+    assert d.evalActiveVoxelBoundingBox() == ((0, 0, 0), (n - 1, n - 1, n - 1)), path
+    assert d.leafCount() == 0, (path, d.leafCount())
+PY
+fi
+[ "$(stat -c %s "$tmp/g1024.binvox" 2>/dev/null)" = $((2 * ((1 << 30) + 254) / 255 + $(grep -a -b -m1 '^data$' "$tmp/g1024.binvox" | cut -d: -f1) + 5)) ] ||
+  fail "g1024.binvox does not have the size of 2^30 set bits"
+rm -f "$tmp"/g1024.binvox "$tmp"/*.vdb
+# An allocation that fails anyway (here the address space is limited below what the budget allows) is one line
+# naming the grid and the output, exit 2, not "vector::reserve" or a bare "out of memory".
+(ulimit -v 1500000; VOX_MEMORY_LIMIT_MB=100000 timeout 20 "$build/vox-export" "$tmp/g1024.vgrid" -o "$tmp/g1024.ply" \
+  --quiet 2>"$tmp/stderr")
+code=$?
+if [ -z "$sanitized" ]; then  # ASan reserves terabytes of address space: no ulimit -v under the sanitizers
+  [ "$code" = 2 ] || fail "out of memory: exit $code, expected 2: $(cat "$tmp/stderr")"
+  grep -q "^vox-export: error: $tmp/g1024.vgrid: $tmp/g1024.ply: out of memory" "$tmp/stderr" ||
+    fail "out of memory does not name the grid and the output: $(cat "$tmp/stderr")"
+fi
+
 if [ "$failures" -gt 0 ]; then echo "$failures failure(s)"; exit 1; fi
 echo "export_voxel_formats: binvox, .vox and .vdb hold exactly the grids' voxels ($grids)"

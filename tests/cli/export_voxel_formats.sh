@@ -153,7 +153,7 @@ crafted() {
 crafted big binvox 2 "binvox: the grid's 2097152 cells on its longest axis exceed"
 crafted big vox 2 "vox: 9223372036854775808 (2^63) voxels need more than 2^64 bytes"
 crafted big vdb 2 "vdb: the voxels need 134217728 root tiles"
-crafted big ply 2 "voxel mesh: a list of 9223372036854775808 (2^63) voxels at 32 bytes each needs more than 2^64"
+crafted big ply 2 "voxel mesh: a list of 9223372036854775808 (2^63) voxels at 32 bytes each needs about 2^64 bytes or more"
 crafted big stl 2 "voxel mesh: a list of 9223372036854775808 (2^63) voxels"
 crafted g16k vox 2 "vox: 4398046511104 (2^42) voxels need at least 17592186044416 (2^44) bytes"
 crafted g16k ply 2 "voxel mesh: a list of 4398046511104 (2^42) voxels"

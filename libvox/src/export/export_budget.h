@@ -8,9 +8,9 @@
 
 namespace vox {
 
-// Throws LimitError "WHERE: WHAT needs about N MiB, more than the M MiB allowed" (N "more than 2^64 bytes" for a
-// saturated estimate, UINT64_MAX) when `bytes` exceeds memoryBudgetBytes(). Called before the allocation the estimate
-// guards.
-void requireMemory(uint64_t bytes, const std::string& where, const std::string& what);
+// Throws LimitError "WHERE: WHAT needs about N MiB, more than the M MiB allowed" (N "2^64 bytes or more" for a
+// saturated estimate, UINT64_MAX) when `bytes` exceeds memoryBudgetBytes(). `verb` replaces "needs about" (an
+// estimate checked as it grows says "need at least"). Called before the allocation the estimate guards.
+void requireMemory(uint64_t bytes, const std::string& where, const std::string& what, const char* verb = "needs about");
 
 }  // namespace vox

@@ -18,6 +18,7 @@
 #include "vox/core/checked_math.h"
 #include "vox/core/error.h"
 #include "vox/export/voxel_runs.h"
+#include "vox/io/input_file.h"
 
 namespace vox {
 
@@ -108,25 +109,36 @@ uint64_t nodeBytes(const NodeTally& t) {
 }
 
 // The density tree's estimate against the root-entry cap and, with `reservedBytes` for the count tree, the memory
-// budget.
+// budget. Each tree's count on a level is capped by the grid's blocks there, the slab's by the two layers of blocks
+// it can reach (a thin box ends in the slab being built and may begin in the one before).
 class TreeBudget {
  public:
-  TreeBudget(const Grid& grid, uint64_t reservedBytes) : caps_(gridBlocks(grid)), reservedBytes_(reservedBytes) {}
+  TreeBudget(const Grid& grid, uint64_t reservedBytes) : caps_(gridBlocks(grid)), reservedBytes_(reservedBytes) {
+    slabCaps_ = caps_;
+    for (int l = 0; l < 3; ++l) {
+      const uint64_t side = kBlockSide[l];
+      const uint64_t plane = saturatingMul((grid.dims[0] + side - 1) / side, (grid.dims[1] + side - 1) / side);
+      slabCaps_.n[l] = std::min(caps_.n[l], saturatingMul(2, plane));
+    }
+    slabCaps_.n[3] = slabCaps_.n[2];
+  }
 
-  // Throws LimitError unless the density tree's nodes so far (`held`) plus `more` fit.
-  void require(const NodeTally& held, const NodeTally& more) const {
-    NodeTally total = held;
-    total.add(more);
-    for (int l = 0; l < kLevels; ++l) total.n[l] = std::min(total.n[l], caps_.n[l]);
-    if (total.n[3] > kMaxRootEntries)
-      fail<LimitError>("vdb: the voxels need ", describeCount(total.n[3]),
-                       " root tiles of 4096^3 cells, more than the ", kMaxRootEntries,
-                       " a .vdb is written with (export a part of the grid)");
-    requireMemory(saturatingAdd(nodeBytes(total), reservedBytes_), "vdb", "the OpenVDB trees of the voxels");
+  // The bytes of the density tree's nodes `density` and the slab's `slab`, with the count tree's; root entries
+  // over the cap throw LimitError.
+  uint64_t bytes(const NodeTally& density, const NodeTally& slab) const {
+    NodeTally d = density, s = slab;
+    for (int l = 0; l < kLevels; ++l) {
+      d.n[l] = std::min(d.n[l], caps_.n[l]);
+      s.n[l] = std::min(s.n[l], slabCaps_.n[l]);
+    }
+    if (d.n[3] > kMaxRootEntries)
+      fail<LimitError>("vdb: the voxels need ", describeCount(d.n[3]), " root tiles of 4096^3 cells, more than the ",
+                       kMaxRootEntries, " a .vdb is written with (export a part of the grid)");
+    return saturatingSum({nodeBytes(d), nodeBytes(s), reservedBytes_});
   }
 
  private:
-  NodeTally caps_;
+  NodeTally caps_, slabCaps_;
   uint64_t reservedBytes_;
 };
 
@@ -209,12 +221,6 @@ class DensityBuilder {
     return density_;
   }
 
-  NodeTally held() const {
-    NodeTally t = densityNodes_;
-    t.add(slabNodes_);
-    return t;
-  }
-
  private:
   using Span = std::pair<uint32_t, uint32_t>;                   // i0, count
   using Rect = std::pair<Span, std::pair<uint32_t, uint32_t>>;  // x span, y range [j0, j1]
@@ -240,8 +246,8 @@ class DensityBuilder {
     const uint32_t i0 = rect.first.first, i1 = rect.first.first + rect.first.second - 1;
     const uint32_t j0 = rect.second.first, j1 = rect.second.second;
     const NodeTally more = boxNodes({i0, j0, k0}, {i1, j1, k1});
-    budget_.require(held(), more);
     const bool thick = k1 - k0 >= 7;
+    require(thick, more);
     (thick ? densityNodes_ : slabNodes_).add(more);
     if (i0 == i1 && j0 == j1 && k0 == k1) {
       slab_->tree().setValueOn(openvdb::Coord(int(i0), int(j0), int(k0)), 1.0f);
@@ -251,6 +257,28 @@ class DensityBuilder {
     tree.sparseFill(
         openvdb::CoordBBox(openvdb::Coord(int(i0), int(j0), int(k0)), openvdb::Coord(int(i1), int(j1), int(k1))), 1.0f,
         true);
+  }
+
+  // Throws LimitError unless the trees with `more` nodes in the density tree (thick) or the slab fit the budget.
+  // The estimates add every fill's nodes, so boxes sharing a block count it once each (rows of one leaf up to 64
+  // times); the first time they pass the budget, both trees are pruned and their nodes counted instead, and the
+  // estimate goes on from there (again only while the trees hold less than half the budget, so that counting, a
+  // walk over their internal nodes, is paid for by the fills that grew the estimate by that half).
+  void require(bool thick, const NodeTally& more) {
+    const auto bytes = [&] {
+      NodeTally d = densityNodes_, s = slabNodes_;
+      (thick ? d : s).add(more);
+      return budget_.bytes(d, s);
+    };
+    const uint64_t limit = memoryBudgetBytes();
+    if (bytes() > limit && recount_) {
+      density_->tree().prune();
+      slab_->tree().prune();
+      densityNodes_ = treeNodes(density_->tree());
+      slabNodes_ = treeNodes(slab_->tree());
+      recount_ = budget_.bytes(densityNodes_, slabNodes_) < limit / 2;
+    }
+    requireMemory(bytes(), "vdb", "the OpenVDB trees of the voxels", "need at least");
   }
 
   void flushSlab() {
@@ -265,6 +293,7 @@ class DensityBuilder {
 
   TreeBudget budget_;
   NodeTally densityNodes_, slabNodes_;  // upper bounds of what each tree holds
+  bool recount_ = true;                 // whether the estimate may still be replaced by a count
   openvdb::FloatGrid::Ptr density_, slab_;
   int64_t layer_ = -1, boxLayer_ = -2, slabK_ = -1;
   std::map<Span, std::pair<uint32_t, uint32_t>> rows_;  // open rectangles of this layer, by x span

@@ -270,13 +270,13 @@ class DensityBuilder {
       (thick ? d : s).add(more);
       return budget_.bytes(d, s);
     };
-    const uint64_t limit = memoryBudgetBytes();
-    if (bytes() > limit && recount_) {
+    if (bytes() <= limit_) return;
+    if (recount_) {
       density_->tree().prune();
       slab_->tree().prune();
       densityNodes_ = treeNodes(density_->tree());
       slabNodes_ = treeNodes(slab_->tree());
-      recount_ = budget_.bytes(densityNodes_, slabNodes_) < limit / 2;
+      recount_ = budget_.bytes(densityNodes_, slabNodes_) < limit_ / 2;
     }
     requireMemory(bytes(), "vdb", "the OpenVDB trees of the voxels", "need at least");
   }
@@ -292,8 +292,9 @@ class DensityBuilder {
   }
 
   TreeBudget budget_;
-  NodeTally densityNodes_, slabNodes_;  // upper bounds of what each tree holds
-  bool recount_ = true;                 // whether the estimate may still be replaced by a count
+  NodeTally densityNodes_, slabNodes_;    // upper bounds of what each tree holds
+  bool recount_ = true;                   // whether the estimate may still be replaced by a count
+  uint64_t limit_ = memoryBudgetBytes();  // read once: it asks the system for its memory
   openvdb::FloatGrid::Ptr density_, slab_;
   int64_t layer_ = -1, boxLayer_ = -2, slabK_ = -1;
   std::map<Span, std::pair<uint32_t, uint32_t>> rows_;  // open rectangles of this layer, by x span

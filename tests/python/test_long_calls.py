@@ -124,6 +124,8 @@ def test_batch_equals_voxelize():
 def test_batch_threads_scale():
     if (os.cpu_count() or 1) < 2:
         pytest.skip("one core")
+    if os.getloadavg()[0] > os.cpu_count() - 0.5:
+        pytest.skip(f"the cores are busy with other work (load {os.getloadavg()[0]:.1f}): no free core to gain")
     meshes = small_meshes(300)
     libvox.voxelize_batch(meshes[:10], 64)
     times = {}

@@ -28,6 +28,7 @@
 #include "vox/export/vdb_writer.h"
 #include "vox/export/voxel_format.h"
 #include "vox/export/voxel_runs.h"
+#include "vox/io/grid_set.h"
 
 namespace vox {
 namespace {
@@ -563,7 +564,7 @@ TEST(HostileSolidRuns, TwoTo63SolidCellsAreRefusedAtOnceByEveryWriter) {
   EXPECT_NE(limitMessage([&] { writeBinvox(out, g); }).find("binvox: the grid's 2097152 cells"), std::string::npos);
   EXPECT_NE(limitMessage([&] {
               writeMagicaVoxel(out, g, {}, kSolidCellColor);
-            }).find("vox: 9223372036854775808 (2^63) voxels need more than 2^64 bytes"),
+            }).find("vox: 9223372036854775808 (2^63) voxels need 2^64 bytes or more"),
             std::string::npos);
   EXPECT_NE(limitMessage([&] { writeVdb(out, g); }).find("vdb: the voxels need 134217728 root tiles"),
             std::string::npos);
@@ -653,6 +654,55 @@ TEST(HostileSolidRuns, NoEstimateWrapsPastTheBudget) {
   std::ostringstream out;
   limitMessage([&] { writeMagicaVoxel(out, g, {}, kSolidCellColor); });
   limitMessage([&] { writeVdb(out, g); });
+}
+
+// The same grid as a set of two bricks (z halves, each one run of 2^62 cells): binvox and .vox read it one layer of
+// bricks at a time (writeGridSetVoxelFile), and refuse it from the first layer's runs; .vdb and the meshes get the
+// assembled set, two runs, and refuse it as the single grid.
+TEST(HostileSolidRuns, TwoTo63SolidCellsInAGridSetAreRefusedAtOnce) {
+  ScopedBudget budget("1024");
+  testing::ScratchDir dir("hostile_set");
+  const std::string path = dir.file("s.vgrid");
+  const Grid whole = oneRunGrid(1u << 21);
+  Grid plan = whole;
+  plan.solidRuns.clear();
+  GridSetManifest m;
+  m.bounds = plan.bounds;
+  m.dims = plan.dims;
+  m.method = plan.method;
+  m.bricks = {1, 1, 2};
+  {
+    GridSetOutput output(path);
+    m.scene = writeGridSetScene(path, output.folder(), Scene{}, plan);
+    for (uint32_t bz = 0; bz < 2; ++bz) {
+      Grid cells = plan;
+      cells.solidRuns = {{uint64_t(bz) << 62, uint64_t(1) << 62}};
+      m.entries.push_back(writeBrickFile(path, m, {0, 0, bz}, cells));
+    }
+    output.commit(m);
+  }
+  const GridSetManifest read = readGridSetManifest(path);
+  const GridFile sceneFile = readGridSetScene(path, read);
+  EXPECT_NE(limitMessage([&] {
+              writeGridSetVoxelFile(dir.file("s.binvox"), VoxelFormat::Binvox, path, read, sceneFile, ColorMode::Count);
+            }).find("binvox: the grid's 2097152 cells"),
+            std::string::npos);
+  for (ColorMode color : {ColorMode::Count, ColorMode::None})
+    EXPECT_NE(limitMessage([&] {
+                writeGridSetVoxelFile(dir.file("s.vox"), VoxelFormat::MagicaVoxel, path, read, sceneFile, color);
+              }).find("vox: 4611686018427387904 (2^62) voxels need 2^64 bytes or more"),
+              std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("s.vox")));
+  const GridFile set = readGridOrSet(path);
+  EXPECT_EQ(tallyVoxels(set.grid).voxels, uint64_t(1) << 63);
+  EXPECT_NE(limitMessage([&] {
+              writeVoxelFile(dir.file("s.vdb"), VoxelFormat::Vdb, set.grid, {});
+            }).find("134217728 root tiles"),
+            std::string::npos);
+  EXPECT_NE(limitMessage([&] {
+              buildVoxelMesh(set.grid, set.scene, FaceMode::Exposed, ColorMode::Count);
+            }).find("(2^63) voxels"),
+            std::string::npos);
 }
 
 // Runs that cross rows and planes, in grids thin and thick: the .vdb builder takes whole rows as rectangles and

@@ -151,7 +151,7 @@ crafted() {
   fi
 }
 crafted big binvox 2 "binvox: the grid's 2097152 cells on its longest axis exceed"
-crafted big vox 2 "vox: 9223372036854775808 (2^63) voxels need more than 2^64 bytes"
+crafted big vox 2 "vox: 9223372036854775808 (2^63) voxels need 2^64 bytes or more"
 crafted big vdb 2 "vdb: the voxels need 134217728 root tiles"
 crafted big ply 2 "voxel mesh: a list of 9223372036854775808 (2^63) voxels at 32 bytes each needs about 2^64 bytes or more"
 crafted big stl 2 "voxel mesh: a list of 9223372036854775808 (2^63) voxels"

@@ -113,9 +113,9 @@ uint64_t minFileBytes(uint64_t voxels, uint64_t models) {
 
 [[noreturn]] void refuseFileSize(uint64_t voxels, uint64_t bytes) {
   fail<LimitError>("vox: ", describeCount(voxels), " voxels need ",
-                   bytes == UINT64_MAX ? "more than 2^64" : "at least " + describeCount(bytes),
-                   " bytes, more than the 2^31 - 1 that the format's int32 chunk sizes allow (export a coarser grid "
-                   "or several bricks)");
+                   bytes == UINT64_MAX ? "2^64 bytes or more" : "at least " + describeCount(bytes) + " bytes",
+                   ", more than the 2^31 - 1 that the format's int32 chunk sizes allow (export a coarser grid or "
+                   "several bricks)");
 }
 
 Census takeCensus(const Grid& plan, const Tiling& tiling, const ColoredPieceSource& pieces, Rgb8 solidColor) {

@@ -8,7 +8,12 @@ packages=(build-essential cmake ninja-build pkg-config python3
   openmpi-bin libopenmpi-dev
   libopenvdb-dev  # vox-export writes .vdb (export/vdb_writer.cpp)
   # The Python package (python/, docs/python.md) and its tests.
-  python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-setuptools python3-venv python3-pip)
+  python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-setuptools python3-venv python3-pip
+  # The viewer page (vox-export -o OUT.html, viewer/): its script is bundled at build time with Node.js and npm.
+  nodejs)
+# npm: Debian's package, unless an npm is already there (NodeSource's nodejs brings its own, and Debian's npm would
+# pull Debian's older nodejs over it).
+command -v npm >/dev/null || packages+=(npm)
 for arg in "$@"; do
   case $arg in
     # bench/python_bench.py compares with Open3D (Debian's 0.16) and draws its bars with tqdm.
@@ -16,7 +21,8 @@ for arg in "$@"; do
     --meshlab) packages+=(meshlab xvfb xauth) ;;
     # Real clients of exported meshes (tests/cli/export_*.sh); numpy for Blender's glTF importer.
     # python3-openvdb (pyopenvdb) reads exported .vdb files back (tests/cli/export_voxel_formats.sh).
-    --clients) packages+=(meshlab xvfb xauth assimp-utils blender python3-numpy python3-openvdb) ;;
+    # chromium: the viewer page's tests (tests/viewer/) in headless Chromium.
+    --clients) packages+=(meshlab xvfb xauth assimp-utils blender python3-numpy python3-openvdb chromium) ;;
     --fuzz) packages+=(clang libclang-rt-14-dev) ;;  # libFuzzer and the sanitizer runtimes (scripts/fuzz.sh)
     --format) packages+=(clang-format git) ;;  # scripts/check-format.sh
     *) echo "install-deps.sh: unknown option $arg" >&2; exit 1 ;;

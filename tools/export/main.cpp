@@ -1,6 +1,7 @@
 // vox-export: grid file -> voxel mesh (.ply .obj .off .stl .glb .gltf).
 #include <unistd.h>
 
+#include <cctype>
 #include <chrono>
 #include <filesystem>
 #include <new>
@@ -14,6 +15,7 @@
 #include "vox/core/progress.h"
 #include "vox/export/voxel_mesh.h"
 #include "vox/export/voxel_format.h"
+#include "vox/export/viewer_page.h"
 
 namespace {
 
@@ -121,9 +123,43 @@ int runVoxelFormat(const Options& opt, vox::VoxelFormat format) {
   return kExitOk;
 }
 
+// The viewer page (.html, vox/export/viewer_page.h): the merged surface, the cells and the scene's primitives in one
+// self-contained page; --faces and --ascii do not apply (the page always draws the merged surface).
+bool isViewerPagePath(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".html" || ext == ".htm";
+}
+
+int runViewerPage(const Options& opt) {
+  using namespace vox;
+  const auto start = std::chrono::steady_clock::now();
+  auto threads = cli::limitThreads(opt.common.threads);
+  if (!viewerPageAvailable()) viewerPageHtml({}, {});  // the build's UsageError, before reading a large grid
+  checkOutputPath(opt.output, {opt.grid});
+  ViewerPageOptions page;
+  page.color = parseColorMode(opt.color);
+  page.title = std::filesystem::path(opt.grid).filename().string();
+  ProgressBar bar("exporting", opt.common.quiet);
+  const GridFile file = readGridOrSet(opt.grid);
+  bar.update(0.3);
+  ViewerDataStats stats;
+  namingGrid(opt, [&] { writeViewerPage(opt.output, file.grid, file.scene, page, &stats); });
+  bar.finish();
+  if (opt.stats)
+    std::fprintf(stderr,
+                 "voxels: %llu\nsurface_vertices: %llu\nsurface_triangles: %llu\nstored_ids: %llu\ndata_bytes: %llu\n"
+                 "output_bytes: %llu\ntotal_seconds: %.6f\n",
+                 (unsigned long long)stats.voxels, (unsigned long long)stats.surfaceVertices,
+                 (unsigned long long)stats.surfaceTriangles, (unsigned long long)stats.storedIds,
+                 (unsigned long long)stats.dataBytes, (unsigned long long)stats.pageBytes, secondsSince(start));
+  return kExitOk;
+}
+
 int run(const Options& opt) {
   using namespace vox;
   if (const auto format = voxelFormatFromPath(opt.output)) return runVoxelFormat(opt, *format);
+  if (isViewerPagePath(opt.output)) return runViewerPage(opt);
   const auto start = std::chrono::steady_clock::now();
   auto threads = cli::limitThreads(opt.common.threads);
   // Refuse a bad output before reading a large grid.
@@ -189,7 +225,7 @@ int main(int argc, char** argv) {
                  "Output mesh: .ply (binary unless --ascii, face colours), .obj (vertex colours), .off (face "
                  "colours), .stl (binary unless --ascii, no colours), .glb/.gltf (vertex colours); voxels: .binvox "
                  "(binvox, cubic voxels), .vox (MagicaVoxel, palette from --color), .vdb (OpenVDB grids density and "
-                 "count)")
+                 "count); .html: an interactive viewer page (three.js inside, opens from disk, no network)")
       ->required();
   app.add_option("--faces", opt.faces,
                  "all: a closed cube of 12 triangles per voxel; exposed (default): the quads between voxels and "

@@ -33,15 +33,13 @@ struct Source {
 
 Source sourceArg(const py::handle& obj, const std::string& what) {
   Source s;
-  if (auto p = pathArg(obj)) {
-    s.path = *p;
-    s.name = *p;
-    return s;
-  }
   s.name = "<arrays>";
   if ((py::isinstance<py::tuple>(obj) || py::isinstance<py::list>(obj)) && py::len(obj) == 2) {
     const py::sequence pair = py::reinterpret_borrow<py::sequence>(obj);
     s.scene = sceneFromArrays(pair[0], pair[1]);
+  } else if (auto p = pathArg(obj)) {
+    s.path = *p;
+    s.name = *p;
   } else if (py::hasattr(obj, "vertices") && py::hasattr(obj, "faces")) {
     s.scene = sceneFromArrays(obj.attr("vertices"), obj.attr("faces"));
   } else {

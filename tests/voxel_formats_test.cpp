@@ -656,6 +656,24 @@ TEST(HostileSolidRuns, NoEstimateWrapsPastTheBudget) {
   limitMessage([&] { writeVdb(out, g); });
 }
 
+// Rows of solid cells one row apart: four exposed squares a voxel, so the squares (counted while the vertices are
+// numbered) are refused where the voxel list's estimate of 32 bytes a voxel still fits.
+TEST(HostileSolidRuns, SquaresOfSolidRowsAreCountedBeforeTheyAreMade) {
+  ScopedBudget budget("100");
+  Grid g = oneRunGrid(1024);
+  g.dims[2] = 2;
+  g.solidRuns.clear();
+  for (uint64_t j = 0; j < 1024; j += 2) g.solidRuns.push_back({j * 1024, 1024});
+  const std::string m = limitMessage([&] { buildVoxelMesh(g, Scene{}, FaceMode::Exposed, ColorMode::None); }, 5.0);
+  EXPECT_NE(m.find("voxel mesh: 2098176 exposed squares needs about"), std::string::npos) << m;
+  // Half as many rows fit, and their mesh has exactly those squares.
+  g.solidRuns.resize(128);
+  VoxelMeshStats stats;
+  const VoxelMesh mesh = buildVoxelMesh(g, Scene{}, FaceMode::Exposed, ColorMode::None, &stats);
+  EXPECT_EQ(stats.exposedFaces, 128u * (4 * 1024 + 2));
+  EXPECT_EQ(mesh.faceCount(), stats.exposedFaces);
+}
+
 // The same grid as a set of two bricks (z halves, each one run of 2^62 cells): binvox and .vox read it one layer of
 // bricks at a time (writeGridSetVoxelFile), and refuse it from the first layer's runs; .vdb and the meshes get the
 // assembled set, two runs, and refuse it as the single grid.

@@ -23,6 +23,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <bit>
 #include <numeric>
 #include <unordered_map>
@@ -295,6 +296,22 @@ struct Pad {
     return connected(m - 1) && connected(m + 1);
   }
 
+  // The exposed faces of the brick's own voxels (local cells 0 .. kBrick - 1): faces whose neighbour is empty, the
+  // squares brickSquares makes, counted from the rows' bits.
+  uint32_t exposedFaces() const {
+    const auto bits = [&](int y, int z, int shift) { return (row(y, z) >> (kPadLo + shift)) & 0xFFu; };
+    uint32_t n = 0;
+    for (int z = 0; z < kBrick; ++z)
+      for (int y = 0; y < kBrick; ++y) {
+        const uint32_t v = bits(y, z, 0);
+        if (!v) continue;
+        for (uint32_t neighbour : {bits(y, z, -1), bits(y, z, 1), bits(y - 1, z, 0), bits(y + 1, z, 0),
+                                   bits(y, z - 1, 0), bits(y, z + 1, 0)})
+          n += uint32_t(std::popcount(v & ~neighbour));
+      }
+    return n;
+  }
+
   // Configuration of lattice point (x,y,z), local lattice coordinates in [0, kBrick].
   uint16_t config(int x, int y, int z, const PointTables& t) const {
     const int occ = octants(x, y, z);
@@ -337,6 +354,7 @@ WorkBricks workBricks(const BrickSet& set) {
 struct VertexNumbering {
   std::vector<std::array<uint16_t, 512>> firstLocal;
   std::vector<uint64_t> base;  // one more than the work bricks: base.back() is the vertex count
+  uint64_t squares = 0;        // exposed squares of the voxels, counted on the way (Pad::exposedFaces)
   uint32_t count(size_t w, int l) const {
     const uint32_t end = l + 1 < 512 ? firstLocal[w][l + 1] : uint32_t(base[w + 1] - base[w]);
     return end - firstLocal[w][l];
@@ -350,11 +368,14 @@ VertexNumbering numberVertices(const BrickSet& set, const WorkBricks& work, cons
   VertexNumbering num;
   num.firstLocal.resize(nWork);
   num.base.assign(nWork + 1, 0);
+  std::atomic<uint64_t> squares{0};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nWork), [&](const tbb::blocked_range<size_t>& r) {
     Pad pad;
+    uint64_t rangeSquares = 0;
     for (size_t w = r.begin(); w != r.end(); ++w) {
       const auto bc = brickCoords(work.keys[w]);
       pad.fill(set, bc[0], bc[1], bc[2]);
+      if (set.index.count(work.keys[w])) rangeSquares += pad.exposedFaces();
       uint32_t running = 0;
       for (int z = 0; z < kBrick; ++z)
         for (int y = 0; y < kBrick; ++y) {
@@ -370,7 +391,9 @@ VertexNumbering numberVertices(const BrickSet& set, const WorkBricks& work, cons
         }
       num.base[w + 1] = running;
     }
+    squares += rangeSquares;
   });
+  num.squares = squares;
   for (size_t w = 0; w < nWork; ++w) num.base[w + 1] += num.base[w];
   checkVertexCount(num.base[nWork]);
   return num;
@@ -484,6 +507,11 @@ ExposedSurface buildExposed(const Voxels& vox, const Lattice& lat) {
 
   requireMemory(saturatingMul(num.base[nWork], sizeof(Vec3) + 1), "voxel mesh",
                 std::to_string(num.base[nWork]) + " vertices");
+  // The squares are made per brick and then copied into one array (each brick's list freed as it is copied):
+  // twice their size at the peak. A row of solid cells has four squares a cell, so this is not bounded by the voxel
+  // list's estimate.
+  requireMemory(saturatingMul(num.squares, 2 * sizeof(Square)), "voxel mesh",
+                std::to_string(num.squares) + " exposed squares");
   ExposedSurface out;
   out.positions.resize(num.base[nWork]);
   out.split.resize(num.base[nWork]);
@@ -506,6 +534,7 @@ ExposedSurface buildExposed(const Voxels& vox, const Lattice& lat) {
     }
   });
   out.squares = concatenate(perBrick);
+  VOX_CHECK(out.squares.size() == num.squares);
   return out;
 }
 

@@ -121,25 +121,35 @@ def test_batch_equals_voxelize():
     assert filled.sum() > dense.sum()
 
 
+def idle_seconds():
+    """Seconds the machine's cores spent idle so far (all cores together), from /proc/stat."""
+    fields = open("/proc/stat").readline().split()
+    return (int(fields[4]) + int(fields[5])) / os.sysconf("SC_CLK_TCK")
+
+
 def test_batch_threads_scale():
-    if (os.cpu_count() or 1) < 2:
+    cores = os.cpu_count() or 1
+    if cores < 2:
         pytest.skip("one core")
-    if os.getloadavg()[0] > os.cpu_count() - 0.5:
-        pytest.skip(f"the cores are busy with other work (load {os.getloadavg()[0]:.1f}): no free core to gain")
     meshes = small_meshes(300)
     libvox.voxelize_batch(meshes[:10], 64)
-    times = {}
+    times, idle, sums = {}, {}, {}
     for threads in (1, 2):
-        best = float("inf")
-        for _ in range(3):  # the best of three: other jobs share the cores
-            start = time.perf_counter()
+        times[threads] = float("inf")
+        for _ in range(3):  # the best of three: other jobs may share the cores
+            idle0, start = idle_seconds(), time.perf_counter()
             out = libvox.voxelize_batch(meshes, 64, threads=threads)
-            best = min(best, time.perf_counter() - start)
-        times[threads] = best
-        times[f"sum{threads}"] = int(out.sum())
-    assert times["sum1"] == times["sum2"]
-    # 2 cores shared with other jobs in CI: a clear gain, not the bench's full 1.7x.
-    assert times[1] / times[2] > 1.3, times
+            wall = time.perf_counter() - start
+            if wall < times[threads]:
+                times[threads], idle[threads] = wall, (idle_seconds() - idle0) / wall
+        sums[threads] = int(out.sum())
+    assert sums[1] == sums[2]
+    speedup = times[1] / times[2]
+    if speedup > 1.3:
+        return  # 2 cores shared with other jobs: a clear gain; bench/python_bench.py measures the full one
+    # No gain: a failure if a core stood idle meanwhile, else the machine was busy with other work.
+    assert idle[2] < 0.3, f"speed-up {speedup:.2f} while {idle[2]:.2f} cores stood idle: {times}"
+    pytest.skip(f"speed-up {speedup:.2f}, but no core was free (other jobs): {times}")
 
 
 def rss_mb():

@@ -168,3 +168,13 @@ def test_save_refuses(tmp_path, grid):
     loaded = libvox.load(vgrid)
     with pytest.raises(libvox.UsageError):
         loaded.save(vgrid)  # its own file
+
+
+def test_load_grid_set(tools, tmp_path):
+    """A grid set (vox-voxelize --bricks) loads as the single grid it stands for."""
+    scene = SCENES / "scene5_07_bunny_mesh_1k.txt"
+    manifest = tmp_path / "set.vgrid"
+    run_tool(tools, "vox-voxelize", scene, "-o", manifest, "--res", 40, "--fill", "--bricks", 3, 2, 2)
+    loaded = libvox.load(manifest)
+    assert_same_grid(loaded, libvox.voxelize(scene, resolution=40, fill=True))
+    assert loaded.solid_count > 0

@@ -3,14 +3,17 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <atomic>
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <span>
 
 #include "voxelize/cell_range.h"
+#include "vox/core/huge_pages.h"
 #include "voxelize/radix_sort.h"
 #include "voxelize/triangle_filter.h"
 #include "vox/core/error.h"
@@ -299,9 +302,14 @@ VoxelizeStats gatherReferences(tbb::enumerable_thread_specific<Local>& locals, b
     local.exactFallbacks += l.fallbacks;
     local.degenerateTriangles += l.degenerate;
   }
-  grid.primIds.reserve(total);
   grid.cellKeys.clear();
   grid.cellStart.clear();
+  grid.primIds.clear();
+  // Sized once, never grown (a grown array is copied and faulted in again): a cell holds at least one reference, so
+  // `total` bounds the cells. Capacity past the cells is address space only: untouched pages take no memory.
+  reserveOnHugePages(grid.primIds, total);
+  reserveOnHugePages(grid.cellKeys, total);
+  reserveOnHugePages(grid.cellStart, total + 1);
   auto appendRef = [&](uint64_t key, uint32_t prim) {
     if (grid.cellKeys.empty() || grid.cellKeys.back() != key) {
       grid.cellKeys.push_back(key);
@@ -310,14 +318,11 @@ VoxelizeStats gatherReferences(tbb::enumerable_thread_specific<Local>& locals, b
     grid.primIds.push_back(prim);
   };
   if (packed) {
-    std::vector<uint64_t> all;
-    all.reserve(total);
-    for (auto& l : locals) {
-      all.insert(all.end(), l.packedRefs.begin(), l.packedRefs.end());
-      std::vector<uint64_t>().swap(l.packedRefs);
-    }
-    radixSort(all, primBits + keyBits);
-    for (uint64_t x : all) appendRef(x >> primBits, uint32_t(x & primMask));
+    std::vector<std::span<const uint64_t>> parts;
+    for (auto& l : locals) parts.emplace_back(l.packedRefs);
+    const auto [sorted, n] = radixSortParts(parts, primBits + keyBits);
+    for (auto& l : locals) std::vector<uint64_t>().swap(l.packedRefs);
+    for (size_t i = 0; i < n; ++i) appendRef(sorted[i] >> primBits, uint32_t(sorted[i] & primMask));
   } else {
     std::vector<std::pair<uint64_t, uint32_t>> all;
     all.reserve(total);
@@ -512,14 +517,16 @@ void voxelizePrimitive(const WindowContext& ctx, size_t id, Local& local) {
 }
 
 // Fails with LimitError when the window's estimated references would take more memory than the options allow.
-void checkReferenceBudget(const Scene& scene, const Grid& grid, const CellWindow& window, const PrimitiveList& ids,
-                          const VoxelizeOptions& options) {
+// Returns the estimate of the window's references (estimateReferences) after checking it against the budget.
+double checkReferenceBudget(const Scene& scene, const Grid& grid, const CellWindow& window, const PrimitiveList& ids,
+                            const VoxelizeOptions& options) {
   const double estimate = estimateReferences(scene, grid, window, ids);
   constexpr double kBytesPerReference = 44;  // packed entry, radix buffer, and the compressed cell lists
   if (estimate * kBytesPerReference > double(options.memoryLimitBytes))
     fail<LimitError>("grid ", grid.dims[0], "x", grid.dims[1], "x", grid.dims[2], " needs about ",
                      uint64_t(estimate * kBytesPerReference / (1 << 20)), " MiB for ", uint64_t(estimate),
                      " cell references, more than the ", options.memoryLimitBytes >> 20, " MiB allowed");
+  return estimate;
 }
 
 // Voxelizes the primitives `ids` into the cells of `window` of the planned `grid`. A primitive's cell tests are the
@@ -529,10 +536,19 @@ void voxelizeWindow(const Scene& scene, Grid& grid, const CellWindow& window, co
                     const VoxelizeOptions& options, VoxelizeStats* stats) {
   const auto start = std::chrono::steady_clock::now();
   const size_t nWork = ids.size();
-  checkReferenceBudget(scene, grid, window, ids, options);
+  const double estimate = checkReferenceBudget(scene, grid, window, ids, options);
   const WindowContext ctx(scene, grid, window, options);
 
-  tbb::enumerable_thread_specific<Local> locals;
+  // Each thread's references reserved once, on huge pages, so that they are never copied to grow: its share of the
+  // (generous) estimate, twice over when threads are few, since the primitives are not spread evenly. Address space
+  // only until written.
+  const double threads = double(std::max(1, tbb::this_task_arena::max_concurrency()));
+  const size_t perThread = size_t(std::min(estimate, estimate * 2 / threads)) + 4096;
+  tbb::enumerable_thread_specific<Local> locals([&] {
+    Local l;
+    if (ctx.packed) reserveOnHugePages(l.packedRefs, perThread);
+    return l;
+  });
   std::atomic<size_t> done{0};
   std::atomic<bool> cancelled{false};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nWork, 256), [&](const tbb::blocked_range<size_t>& r) {

@@ -190,8 +190,9 @@ void runWriter(const char* writer, F&& write) {
 // a writer's legitimate work is its output: .vox needs 4 bytes a voxel and the meshes tens, so they run on grids of
 // up to 2^16 voxels, and on larger ones only when their estimates must refuse them (over 2^29 voxels: past .vox's
 // 2^31 bytes and the budget), where a hang is a finding; binvox visits every row of its cube twice (up to 2^24), so
-// it runs up to 2^20 rows, and beyond when its dimension must be refused. .vdb always runs: its work is bounded by
-// the runs and its estimate.
+// it runs up to 2^20 rows, and beyond when its dimension must be refused. Grids that break the rules go to every
+// writer (each checks the keys and runs before its first row). .vdb always runs: its work is bounded by the runs
+// and its estimate.
 inline void exerciseVoxelWriters(const Grid& grid, const Scene& scene, ColorMode color) {
   VoxelTally tally{UINT64_MAX, UINT64_MAX};
   try {

@@ -117,6 +117,8 @@ BinvoxLayout binvoxLayout(const Grid& grid) {
 }
 
 BinvoxLayout writeBinvox(std::ostream& out, const Grid& grid, const std::function<void(double)>& progress) {
+  binvoxLayout(grid);  // a cube too large is refused before anything else
+  tallyVoxels(grid);   // and keys or runs that break the grid's rules before a row is visited
   return writeBinvox(out, grid, voxelRows(grid), progress);
 }
 

@@ -66,6 +66,10 @@ for i in range(15):
 PY
 check res 0 "$V" "$SRC/scenes/scene5_12_nested_transformations.txt" -o "$T/n.vgrid" --res 20 --method sat --stats
 grep -q "^occupied_cells: " "$T/err" || { echo "FAIL --stats"; fails=$((fails + 1)); }
+# The phases of the whole process, each timed (issue 26): read, voxelize, write, sync.
+for f in read_seconds voxelize_seconds write_seconds sync_seconds total_seconds; do
+  grep -q "^$f: [0-9]" "$T/err" || { echo "FAIL --stats lacks $f"; fails=$((fails + 1)); }
+done
 
 # Bad input: one line naming the file, exit codes 1 usage, 2 bad input, 3 cannot write.
 check missing_scene 2 "$V" "$T/none.txt" -o "$T/x.vgrid"; expect_err missing_scene "none.txt"

@@ -113,6 +113,7 @@ int run(const Options& opt) {
   if (!opt.bricks.empty()) checkGridSetOutput(opt.output);  // "-o foo.bricks": refused before any work
   const std::optional<GridSetManifest> previousSet = opt.bricks.empty() ? previousGridSet(opt.output) : std::nullopt;
   const Scene scene = loadScene(opt.scene);
+  const double readSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!opt.common.quiet)
     for (const auto& w : scene.warnings) std::fputs(warningLine("vox-voxelize", w).c_str(), stderr);
   if (!opt.bricks.empty()) return runSet(opt, scene, vo, start);
@@ -148,7 +149,8 @@ int run(const Options& opt) {
                                                " primitives stick out of the given bounds (traced separately)")
                    .c_str(),
                stderr);
-  writeGridFile(opt.output, scene, grid);
+  WriteTimes writeTimes;
+  writeGridFile(opt.output, scene, grid, &writeTimes);
   if (previousSet) removeGridSetFiles(opt.output, *previousSet);  // a grid file replaced a set: its files go too
 
   if (opt.stats) {
@@ -158,12 +160,14 @@ int run(const Options& opt) {
     std::fprintf(stderr,
                  "triangles: %zu\nspheres: %zu\nplanes: %zu\ndegenerate_triangles: %llu\ndims: %u %u %u\nmethod: %s\n"
                  "cells_tested: %llu\nexact_fallbacks: %llu\noccupied_cells: %zu\nsolid_cells: %llu\nreferences: %zu\n"
-                 "voxelize_seconds: %.6f\ntotal_seconds: %.6f\npeak_memory_mb: %.1f\n",
+                 "read_seconds: %.6f\nvoxelize_seconds: %.6f\nwrite_seconds: %.6f\nsync_seconds: %.6f\n"
+                 "total_seconds: %.6f\npeak_memory_mb: %.1f\n",
                  scene.triangles.size(), scene.spheres.size(), scene.planes.size(),
                  (unsigned long long)stats.degenerateTriangles, grid.dims[0], grid.dims[1], grid.dims[2],
                  methodName(grid.method).c_str(), (unsigned long long)stats.cellsTested,
                  (unsigned long long)stats.exactFallbacks, grid.occupiedCount(), (unsigned long long)grid.solidCount(),
-                 grid.referenceCount(), stats.seconds, total, double(usage.ru_maxrss) / 1024.0);
+                 grid.referenceCount(), readSeconds, stats.seconds, writeTimes.writeSeconds, writeTimes.syncSeconds,
+                 total, double(usage.ru_maxrss) / 1024.0);
   }
   return kExitOk;
 }

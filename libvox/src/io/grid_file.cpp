@@ -3,6 +3,7 @@
 #include "vox/io/grid_file.h"
 
 #include <bit>
+#include <chrono>
 #include <cstring>
 #include <limits>
 
@@ -401,7 +402,9 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
   return out;
 }
 
-void writeGridFile(const std::string& path, const Scene& scene, const Grid& grid) {
+void writeGridFile(const std::string& path, const Scene& scene, const Grid& grid, WriteTimes* times) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
   // Three passes over the encoding instead of the whole file in memory (at 1024^3 the file is as large as the grid):
   // the size, which seeds the checksum; the checksum; then the bytes, header first, through a temporary file.
   uint64_t size = 0;
@@ -411,7 +414,13 @@ void writeGridFile(const std::string& path, const Scene& scene, const Grid& grid
   OutputFile out(path);
   out.write(encodeHeader(size, sum.value()));
   streamPayload(scene, grid, [&](std::string_view bytes) { out.write(bytes); });
+  out.flush();
+  const auto written = Clock::now();
   out.commit();
+  if (times) {
+    times->writeSeconds = std::chrono::duration<double>(written - start).count();
+    times->syncSeconds = std::chrono::duration<double>(Clock::now() - written).count();
+  }
 }
 
 GridFile readGridFile(const std::string& path) {

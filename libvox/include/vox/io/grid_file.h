@@ -19,7 +19,13 @@ struct GridFile {
 
 // Writes to `path` through a temporary file in the same folder and a rename, so a failure leaves no partial file.
 // Throws OutputError naming the path.
-void writeGridFile(const std::string& path, const Scene& scene, const Grid& grid);
+// Where writeGridFile's time went (vox-voxelize --stats): encoding and writing the bytes, and making them durable
+// (fsync of the file, rename, fsync of the folder).
+struct WriteTimes {
+  double writeSeconds = 0;
+  double syncSeconds = 0;
+};
+void writeGridFile(const std::string& path, const Scene& scene, const Grid& grid, WriteTimes* times = nullptr);
 
 // Reads and checks every count, offset, id and the checksum. Throws InputError naming the path and the byte offset
 // for a truncated, corrupt or newer-version file.

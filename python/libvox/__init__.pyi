@@ -59,18 +59,26 @@ class Grid:
         progress: _Progress = False,
     ) -> None: ...
     def mesh(
-        self, *, faces: str = "merged", color: str = "none", threads: Optional[int] = None
+        self, faces: str = "merged", color: str = "none", *, threads: Optional[int] = None
     ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int32], Optional[npt.NDArray[np.uint8]]]: ...
     def colors(self, mode: str = "material") -> npt.NDArray[np.uint8]: ...
     def intersect(
-        self, origins: _Array, directions: _Array, tmax: Union[float, _Array] = ..., *,
-        accel: str = "grid",
+        self,
+        origins: _Array,
+        directions: _Array,
+        tmax: Union[float, _Array] = ...,
         threads: Optional[int] = None,
+        *,
+        accel: str = "grid",
     ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64], npt.NDArray[np.float64]]: ...
     def occluded(
-        self, origins: _Array, directions: _Array, tmax: Union[float, _Array] = ..., *,
-        accel: str = "grid",
+        self,
+        origins: _Array,
+        directions: _Array,
+        tmax: Union[float, _Array] = ...,
         threads: Optional[int] = None,
+        *,
+        accel: str = "grid",
     ) -> npt.NDArray[np.bool_]: ...
 
 def load(path: _Path) -> Grid: ...

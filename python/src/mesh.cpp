@@ -54,7 +54,7 @@ py::array_t<uint8_t> colors(PyGrid& self, const std::string& modeName) {
 }  // namespace
 
 void bindMesh(GridClass& grid) {
-  grid.def("mesh", &mesh, py::kw_only(), py::arg("faces") = "merged", py::arg("color") = "none",
+  grid.def("mesh", &mesh, py::arg("faces") = "merged", py::arg("color") = "none", py::kw_only(),
            py::arg("threads") = py::none(), R"doc(
 The voxels (occupied and solid cells) as a triangle mesh, as vox-export builds it: vertices (V, 3) float64 on the
 cell lattice (world space), faces (F, 3) int32, counter-clockwise seen from outside, and face_colors (F, 4) uint8

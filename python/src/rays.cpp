@@ -74,7 +74,7 @@ const vox::Accel& accelFor(PyGrid& self, vox::AccelKind kind, std::unique_ptr<vo
 }
 
 py::tuple intersect(PyGrid& self, const py::handle& origins, const py::handle& directions, const py::handle& tmax,
-                    const std::string& accelName, const py::object& threads) {
+                    const py::object& threads, const std::string& accelName) {
   const vox::AccelKind kind = vox::parseAccel(accelName);
   const RayBatch rays = rayBatch(origins, directions, tmax);
   const auto nThreads = threadsArg(threads);
@@ -103,7 +103,7 @@ py::tuple intersect(PyGrid& self, const py::handle& origins, const py::handle& d
 }
 
 py::array_t<bool> occludedRays(PyGrid& self, const py::handle& origins, const py::handle& directions,
-                               const py::handle& tmax, const std::string& accelName, const py::object& threads) {
+                               const py::handle& tmax, const py::object& threads, const std::string& accelName) {
   const vox::AccelKind kind = vox::parseAccel(accelName);
   const RayBatch rays = rayBatch(origins, directions, tmax);
   const auto nThreads = threadsArg(threads);
@@ -124,8 +124,8 @@ py::array_t<bool> occludedRays(PyGrid& self, const py::handle& origins, const py
 
 void bindRays(GridClass& grid) {
   grid.def("intersect", &intersect, py::arg("origins"), py::arg("directions"),
-           py::arg("tmax") = std::numeric_limits<double>::infinity(), py::kw_only(), py::arg("accel") = "grid",
-           py::arg("threads") = py::none(),
+           py::arg("tmax") = std::numeric_limits<double>::infinity(), py::arg("threads") = py::none(), py::kw_only(),
+           py::arg("accel") = "grid",
            R"doc(
 The nearest hit of each ray origin + t * direction, t in [0, tmax], through the exact grid walk of vox-trace: the
 same hit as testing every primitive (brute force), bit for bit, on exact, sat and bbox grids; ties go to the smaller
@@ -138,8 +138,8 @@ accel 'none' tests every primitive for every ray instead (brute force: the refer
 The trace structure is built on the first call and kept. The GIL is released; Ctrl-C stops it.
 )doc");
   grid.def("occluded", &occludedRays, py::arg("origins"), py::arg("directions"),
-           py::arg("tmax") = std::numeric_limits<double>::infinity(), py::kw_only(), py::arg("accel") = "grid",
-           py::arg("threads") = py::none(),
+           py::arg("tmax") = std::numeric_limits<double>::infinity(), py::arg("threads") = py::none(), py::kw_only(),
+           py::arg("accel") = "grid",
            R"doc(
 Whether anything is hit for t in [0, tmax] (shadow rays): (R,) bool, equal to intersect(...)[0] <= tmax.
 )doc");

@@ -40,6 +40,8 @@ Source sourceArg(const py::handle& obj, const std::string& what) {
   } else if (auto p = pathArg(obj)) {
     s.path = *p;
     s.name = *p;
+    if (p->size() > 6 && p->compare(p->size() - 6, 6, ".vgrid") == 0)
+      vox::fail<vox::UsageError>(*p, ": a grid file, not a scene: libvox.load reads it");
   } else if (py::hasattr(obj, "vertices") && py::hasattr(obj, "faces")) {
     s.scene = sceneFromArrays(obj.attr("vertices"), obj.attr("faces"));
   } else {

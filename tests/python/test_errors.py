@@ -44,6 +44,8 @@ def test_bad_sources_and_options(tmp_path):
         libvox.voxelize(42)
     with pytest.raises(libvox.InputError, match="missing.obj"):
         libvox.voxelize(tmp_path / "missing.obj")
+    with pytest.raises(libvox.UsageError, match="a grid file, not a scene: libvox.load reads it"):
+        libvox.voxelize(tmp_path / "g.vgrid")
     with pytest.raises(libvox.InputError, match="unknown scene format"):
         libvox.voxelize(SCENES / "README.md")
     with pytest.raises(libvox.UsageError, match="at most one of resolution, dims and pitch"):

@@ -348,13 +348,15 @@ Image traceImage(const Scene& scene, const Accel& accel, const RenderOptions& op
                       const auto rows = tile.rows(), cols = tile.cols();
                       for (uint32_t by = rows.begin(); by < rows.end(); by += Renderer::kBlock) {
                         const uint32_t byEnd = std::min(by + Renderer::kBlock, rows.end());
-                        for (uint32_t bx = cols.begin(); bx < cols.end(); bx += Renderer::kBlock)
-                          r.renderBlock(bx, std::min(bx + Renderer::kBlock, cols.end()), by, byEnd, image, store, st);
-                        // After every row of blocks, not every band of the image's rows: a caller that cancels by
-                        // throwing from progress (the Python module on Ctrl-C) waits for a few blocks (issue 24).
-                        if (options.progress) {
-                          const uint64_t done = uint64_t(byEnd - by) * cols.size();
-                          options.progress(double(pixelsDone.fetch_add(done) + done) / pixels);
+                        for (uint32_t bx = cols.begin(); bx < cols.end(); bx += Renderer::kBlock) {
+                          const uint32_t bxEnd = std::min(bx + Renderer::kBlock, cols.end());
+                          r.renderBlock(bx, bxEnd, by, byEnd, image, store, st);
+                          // After every block, not every band of the image's rows: a caller that cancels by
+                          // throwing from progress (the Python module on Ctrl-C) waits for one block (issue 24).
+                          if (options.progress) {
+                            const uint64_t done = uint64_t(byEnd - by) * (bxEnd - bx);
+                            options.progress(double(pixelsDone.fetch_add(done) + done) / pixels);
+                          }
                         }
                       }
                     });

@@ -50,8 +50,8 @@ struct RenderOptions {
   double filterRadius = 0.5;             // pixels
   Camera camera;                         // already resolved (scene camera, overrides or defaultCamera)
   uint64_t seed = 0;                     // of the per-pixel jitter
-  // Called from worker threads after each row of blocks of a tile with the fraction of pixels done; may be empty.
-  // May throw to cancel (the exception leaves traceImage).
+  // Called from worker threads after each block of 8x8 pixels with the fraction of pixels done; may be empty. May
+  // throw to cancel (the exception leaves traceImage).
   std::function<void(double)> progress;
 };
 

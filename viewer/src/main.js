@@ -7,7 +7,7 @@ import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { bytesFromChunks, decodeViewerData } from './data.js';
 import { formatHash, parseHash, resolveCamera } from './camera.js';
 import { Cells } from './cells.js';
-import { surfaceMaterial } from './surface.js';
+import { cubes, surfaceMaterial } from './surface.js';
 import { buildPanel } from './panel.js';
 
 // Colours pass through unchanged: the page shows vox-export's sRGB bytes as they are, like the mesh files do.
@@ -27,9 +27,14 @@ function fail(message) {
 
 function start() {
   const chunks = [...document.querySelectorAll('script[type="application/x-vox-data"]')].map((s) => s.textContent);
+  // Milliseconds since navigation began at each stage, for bench/viewer_bench.mjs.
+  const timings = { scriptStart: performance.now() };
+  api.timings = timings;
   const data = decodeViewerData(bytesFromChunks(chunks));
+  timings.decoded = performance.now();
   api.data = data;
   const cells = new Cells(data);
+  timings.cellsIndexed = performance.now();
   api.cells = cells;
 
   const canvas = document.createElement('canvas');
@@ -55,7 +60,12 @@ function start() {
   const surface = surfaceMaterial(data, origin, cellSize);
   const voxels = new THREE.Group();
   scene.add(voxels);
-  if (data.triangleCount > 0) {
+  const drawCubes = new URLSearchParams(window.location.search).get('voxels') === 'cubes';
+  if (drawCubes && cells.total > 0) {
+    const material = surfaceMaterial(data, origin, cellSize, true);
+    material.uniforms = surface.uniforms;  // one slice and one set of toggles for both
+    voxels.add(cubes(cells, material));
+  } else if (data.triangleCount > 0) {
     const g = new THREE.BufferGeometry();
     g.setAttribute('lattice', new THREE.BufferAttribute(data.vertices, 3));
     if (data.hasColors) g.setAttribute('vcolor', new THREE.BufferAttribute(data.vertexColors, 3, true));
@@ -234,6 +244,7 @@ function start() {
     requestAnimationFrame(() => {
       pending = false;
       fitClipPlanes();
+      if (!timings.firstRender) timings.firstRender = performance.now();
       renderer.render(scene, camera);
       ++frames;
       api.frames = frames;
@@ -241,6 +252,7 @@ function start() {
         // The frame is on screen once the next one starts.
         requestAnimationFrame(() => {
           api.firstFrameMs = performance.now();
+          timings.firstFrame = api.firstFrameMs;
           api.ready = true;
           document.body.dataset.ready = '1';
         });
@@ -371,6 +383,23 @@ function start() {
     if (e.key === 'h' && !(e.target instanceof HTMLInputElement)) panel.toggleHidden();
   });
 
+  // For bench/viewer_bench.mjs: renders `n` frames, turning the camera a little about the orbit target each time
+  // (as a drag does), each one waited for (a one-pixel read-back); milliseconds per frame.
+  api.timeFrames = (n) => {
+    const gl = renderer.getContext();
+    const pixel = new Uint8Array(4);
+    const t0 = performance.now();
+    for (let f = 0; f < n; ++f) {
+      const offset = camera.position.clone().sub(controls.target);
+      offset.applyAxisAngle(camera.up, 0.05);
+      camera.position.copy(controls.target).add(offset);
+      camera.lookAt(controls.target);
+      fitClipPlanes();
+      renderer.render(scene, camera);
+      gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, pixel);
+    }
+    return (performance.now() - t0) / n;
+  };
   api.setSlice = setSlice;
   api.pickAt = (x, y) => pick.at(x, y);
   api.view = () => currentView();

@@ -6,7 +6,12 @@ import * as THREE from 'three';
 const vertexShader = /* glsl */ `
 uniform vec3 uOrigin;
 uniform vec3 uCell;
+#ifdef VOX_INSTANCED
+// One unit cube (three.js' BoxGeometry, centred on 0) per voxel, at the voxel's lattice corner.
+attribute vec3 cell;
+#else
 attribute vec3 lattice;
+#endif
 #ifdef VOX_COLORS
 attribute vec3 vcolor;
 #endif
@@ -14,6 +19,9 @@ varying vec3 vLattice;
 varying vec3 vView;
 varying vec3 vColor;
 void main() {
+#ifdef VOX_INSTANCED
+  vec3 lattice = cell + position + 0.5;
+#endif
   vLattice = lattice;
   vec4 view = modelViewMatrix * vec4(uOrigin + lattice * uCell, 1.0);
   vView = view.xyz;
@@ -64,12 +72,15 @@ void main() {
 }
 `;
 
-// data: the decoded layout; origin: lo - centre; cell: (hi - lo) / dims.
-export function surfaceMaterial(data, origin, cell) {
+// data: the decoded layout; origin: lo - centre; cell: (hi - lo) / dims. instanced: for cubes() below.
+export function surfaceMaterial(data, origin, cell, instanced = false) {
+  const defines = {};
+  if (data.hasColors) defines.VOX_COLORS = 1;
+  if (instanced) defines.VOX_INSTANCED = 1;
   return new THREE.ShaderMaterial({
     vertexShader,
     fragmentShader,
-    defines: data.hasColors ? { VOX_COLORS: 1 } : {},
+    defines,
     uniforms: {
       uOrigin: { value: new THREE.Vector3(...origin) },
       uCell: { value: new THREE.Vector3(...cell) },
@@ -80,4 +91,41 @@ export function surfaceMaterial(data, origin, cell) {
     },
     side: THREE.DoubleSide,
   });
+}
+
+// The other way to draw voxels, kept to measure against the merged surface (bench/viewer_bench.mjs; the page's
+// `?voxels=cubes`): one instanced cube of 12 triangles per voxel, occupied and solid. The merged surface draws
+// far fewer triangles and renders faster (README, "Viewer page").
+export function cubes(cells, material) {
+  const d = cells.d;
+  const n = cells.total;
+  const corner = new Float32Array(3 * n);
+  const colors = d.hasColors ? new Uint8Array(3 * n) : null;
+  let v = 0;
+  const ny = d.dims[1];
+  const put = (i, j, k, c) => {
+    corner[3 * v] = i;
+    corner[3 * v + 1] = j;
+    corner[3 * v + 2] = k;
+    if (colors) colors.set(cells.color(c), 3 * v);
+    ++v;
+  };
+  for (let r = 0; r < d.rowCount; ++r) {
+    const j = d.rowKeys[r] % ny;
+    const k = (d.rowKeys[r] - j) / ny;
+    for (let c = d.rowStart[r]; c < d.rowStart[r + 1]; ++c) put(d.cellI[c], j, k, c);
+  }
+  cells.forEachSolidSegment((i0, i1, j, k) => {
+    for (let i = i0; i <= i1; ++i) put(i, j, k, -1);
+  });
+  const box = new THREE.BoxGeometry(1, 1, 1);
+  const g = new THREE.InstancedBufferGeometry();
+  g.setIndex(box.getIndex());
+  g.setAttribute('position', box.getAttribute('position'));
+  g.setAttribute('cell', new THREE.InstancedBufferAttribute(corner, 3));
+  if (colors) g.setAttribute('vcolor', new THREE.InstancedBufferAttribute(colors, 3, true));
+  g.instanceCount = n;
+  const mesh = new THREE.Mesh(g, material);
+  mesh.frustumCulled = false;
+  return mesh;
 }

@@ -55,6 +55,7 @@ class Grid:
         faces: str = "exposed",
         color: str = "count",
         ascii: bool = False,
+        bricks: Union[None, int, Sequence[int]] = None,
         threads: Optional[int] = None,
         progress: _Progress = False,
     ) -> None: ...

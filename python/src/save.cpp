@@ -6,6 +6,9 @@
 #include "vox/export/voxel_format.h"
 #include "vox/export/voxel_mesh.h"
 #include "vox/io/atomic_file.h"
+#include "vox/io/grid_set.h"
+#include "vox/io/input_file.h"
+#include "vox/voxelize/bricks.h"
 
 namespace voxpy {
 
@@ -30,8 +33,37 @@ void warn(const std::string& message) {
   if (PyErr_WarnEx(PyExc_UserWarning, message.c_str(), 1) != 0) throw py::error_already_set();
 }
 
+// A grid set of the grid (vox-voxelize --bricks): the set's writer voxelizes the grid's scene brick by brick under
+// the grid's own plan (bounds, dims, method; the fill when the grid has solid cells), which gives the grid's cells
+// (grid_set.h: a brick holds exactly the single grid's cells); the totals are checked against the grid's.
+void saveGridSet(const PyGrid& self, const std::string& path, const std::array<uint32_t, 3>& bricks,
+                 Interrupt& interrupt) {
+  const vox::Grid& grid = self.grid();
+  vox::VoxelizeOptions vo;
+  vo.bounds = grid.bounds;
+  vo.dims = grid.dims;
+  vo.method = grid.method;
+  vo.memoryLimitBytes = vox::memoryBudgetBytes();
+  vo.progress = [&](double f) { return interrupt.poll(0.8 * f); };
+  vox::FillOptions fo;
+  fo.memoryLimitBytes = vo.memoryLimitBytes;
+  fo.progress = [&](double f) { return interrupt.poll(0.8 + 0.2 * f); };
+  const vox::GridSetManifest set =
+      vox::writeGridSet(path, self.scene(), vo, bricks, nullptr, grid.solidRuns.empty() ? nullptr : &fo);
+  uint64_t occupied = 0, references = 0, solid = 0;
+  for (const vox::BrickEntry& e : set.entries) {
+    occupied += e.occupied;
+    references += e.references;
+    solid += e.solid;
+  }
+  if (occupied != grid.occupiedCount() || references != grid.referenceCount() || solid != grid.solidCount())
+    vox::fail<vox::InputError>(self.source(), ": the grid's cells are not the voxelization of its scene (",
+                               grid.occupiedCount(), " occupied cells, the set has ", occupied,
+                               "): it cannot be written as a grid set");
+}
+
 void save(PyGrid& self, const py::object& pathObj, const std::string& facesName, const std::string& colorName,
-          bool ascii, const py::object& threads, const py::object& progress) {
+          bool ascii, const py::object& bricksArg, const py::object& threads, const py::object& progress) {
   const auto path = pathArg(pathObj);
   if (!path) throw py::type_error("path must be a str or os.PathLike");
   const vox::FaceMode faces = optionArg("faces", facesName, vox::parseFaceMode);
@@ -43,6 +75,12 @@ void save(PyGrid& self, const py::object& pathObj, const std::string& facesName,
   const auto voxelFormat = vox::voxelFormatFromPath(*path);
   const bool gridFile = isGridFilePath(*path);
   if (!gridFile && !voxelFormat) optionArg("path", *path, vox::meshFormatFromPath);
+  std::optional<std::array<uint32_t, 3>> bricks;
+  if (!bricksArg.is_none()) {
+    if (!gridFile) vox::fail<vox::UsageError>("bricks: only a .vgrid output is written as a grid set");
+    bricks = dims3Arg(bricksArg, "bricks");
+    vox::checkBrickCounts(self.grid().dims, *bricks);
+  }
   vox::checkOutputPath(*path, inputs);
   if (!gridFile && !voxelFormat && vox::meshFormatFromPath(*path) == vox::MeshFormat::Obj)
     vox::checkOutputPath(std::filesystem::path(*path).replace_extension(".mtl").string(), inputs);
@@ -54,7 +92,9 @@ void save(PyGrid& self, const py::object& pathObj, const std::string& facesName,
   vox::VoxelFileReport report;
   runLong(interrupt, nThreads, [&] {
     const vox::Grid& grid = self.grid();
-    if (gridFile) {
+    if (gridFile && bricks) {
+      saveGridSet(self, *path, *bricks, interrupt);
+    } else if (gridFile) {
       vox::writeGridFile(*path, self.scene(), grid);
     } else if (voxelFormat) {
       std::vector<vox::Rgb8> colors;
@@ -80,9 +120,11 @@ void save(PyGrid& self, const py::object& pathObj, const std::string& facesName,
 
 void bindSave(GridClass& grid) {
   grid.def("save", &save, py::arg("path"), py::kw_only(), py::arg("faces") = "exposed", py::arg("color") = "count",
-           py::arg("ascii") = false, py::arg("threads") = py::none(), py::arg("progress") = false, R"doc(
+           py::arg("ascii") = false, py::arg("bricks") = py::none(), py::arg("threads") = py::none(),
+           py::arg("progress") = false, R"doc(
 Writes the grid in the format of the path's extension, as vox-voxelize and vox-export write it:
-  .vgrid: the grid file with its scene (libvox.load and the tools read it);
+  .vgrid: the grid file with its scene (libvox.load and the tools read it); with bricks=(bx, by, bz), a grid set
+      as vox-voxelize --bricks writes it (its scene voxelized again brick by brick under the grid's plan);
   .ply .obj .off .stl .glb .gltf: the voxels as a mesh; faces 'all' (a cube per voxel), 'exposed' (closed,
       2-manifold) or 'merged' (exposed faces merged into rectangles); color 'count', 'material' or 'none';
       ascii=True for ASCII PLY/STL;

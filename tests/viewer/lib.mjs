@@ -81,8 +81,9 @@ export async function launch() {
 }
 
 // Opens the page at `htmlPath` (with `hash`) in a new page of `size` [w, h] and waits for its first frame. Returns
-// {page, errors (console errors and page errors), requests (every URL requested)}.
-export async function openPage(browser, htmlPath, { hash = '', size = [480, 360], timeout = 120000 } = {}) {
+// {page, errors (console errors and page errors), requests (every URL requested)}. query: '?name=value' for the
+// page's options (?voxels=cubes).
+export async function openPage(browser, htmlPath, { hash = '', query = '', size = [480, 360], timeout = 120000 } = {}) {
   const context = await browser.newContext({ viewport: { width: size[0], height: size[1] }, deviceScaleFactor: 1 });
   const page = await context.newPage();
   const errors = [];
@@ -92,7 +93,7 @@ export async function openPage(browser, htmlPath, { hash = '', size = [480, 360]
   });
   page.on('pageerror', (e) => errors.push(String(e)));
   page.on('request', (r) => requests.push(r.url()));
-  const url = pathToFileURL(htmlPath).href + hash;
+  const url = pathToFileURL(htmlPath).href + query + hash;
   await page.goto(url, { timeout });
   await page.waitForFunction(() => window.voxViewer && (window.voxViewer.ready || window.voxViewer.error), null, {
     timeout,

@@ -8,7 +8,12 @@ import { bytesFromChunks, decodeViewerData } from './data.js';
 import { formatHash, parseHash, resolveCamera } from './camera.js';
 import { Cells } from './cells.js';
 import { cubes, surfaceMaterial } from './surface.js';
+import { blockFactor, blockSurface } from './lod.js';
 import { buildPanel } from './panel.js';
+
+// Surfaces of more triangles than this get a coarse stand-in of about LOD_TRIANGLES (lod.js).
+const LOD_FROM_TRIANGLES = 1500000;
+const LOD_TRIANGLES = 300000;
 
 // Colours pass through unchanged: the page shows vox-export's sRGB bytes as they are, like the mesh files do.
 THREE.ColorManagement.enabled = false;
@@ -60,6 +65,7 @@ function start() {
   const surface = surfaceMaterial(data, origin, cellSize);
   const voxels = new THREE.Group();
   scene.add(voxels);
+  let fullMesh = null;
   const drawCubes = new URLSearchParams(window.location.search).get('voxels') === 'cubes';
   if (drawCubes && cells.total > 0) {
     const material = surfaceMaterial(data, origin, cellSize, true);
@@ -74,8 +80,26 @@ function start() {
     const mesh = new THREE.Mesh(g, surface);
     mesh.frustumCulled = false;
     voxels.add(mesh);
+    fullMesh = mesh;
   }
   let capMesh = null;
+  // Large surfaces: a coarse stand-in (lod.js) for the first frame and while the camera moves.
+  const lod = { mesh: null, factor: 1, coarse: false, timer: 0 };
+  api.lod = lod;
+  if (fullMesh && data.triangleCount > LOD_FROM_TRIANGLES) {
+    lod.factor = blockFactor(data.triangleCount, LOD_TRIANGLES);
+    const blocks = blockSurface(cells, lod.factor);
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('lattice', new THREE.BufferAttribute(blocks.lattice, 3));
+    if (blocks.colors) g.setAttribute('vcolor', new THREE.BufferAttribute(blocks.colors, 3, true));
+    g.setIndex(new THREE.BufferAttribute(Uint32Array.from({ length: 6 * blocks.faces }, (_, v) => v), 1));
+    lod.mesh = new THREE.Mesh(g, surface);
+    lod.mesh.frustumCulled = false;
+    lod.faces = blocks.faces;
+    voxels.add(lod.mesh);
+    lod.coarse = true;
+  }
+  timings.built = performance.now();
 
   // Overlays: the grid's bounds, the scene's triangles and spheres.
   const boundsLines = new THREE.LineSegments(
@@ -143,7 +167,9 @@ function start() {
     controls.zoomToCursor = true;
     controls.addEventListener('start', () => {
       userMoved = true;
+      setCoarse(true);
     });
+    controls.addEventListener('end', () => setCoarse(false, 400));
     controls.addEventListener('change', () => {
       render();
       if (userMoved) {
@@ -238,13 +264,32 @@ function start() {
   // Renders at most once per animation frame.
   let pending = false;
   let frames = 0;
+  // The coarse stand-in now, or the full surface (after `delay` ms without another call).
+  function setCoarse(coarse, delay = 0) {
+    if (!lod.mesh) return;
+    clearTimeout(lod.timer);
+    if (coarse) {
+      lod.coarse = true;
+      return;
+    }
+    lod.timer = setTimeout(() => {
+      lod.coarse = false;
+      render();
+    }, delay);
+  }
   render = () => {
     if (pending) return;
     pending = true;
     requestAnimationFrame(() => {
       pending = false;
       fitClipPlanes();
+      if (lod.mesh) {
+        lod.mesh.visible = lod.coarse;
+        fullMesh.visible = !lod.coarse;
+        if (capMesh) capMesh.visible = !lod.coarse;
+      }
       if (!timings.firstRender) timings.firstRender = performance.now();
+      if (!lod.coarse && !timings.firstFullRender) timings.firstFullRender = performance.now();
       renderer.render(scene, camera);
       ++frames;
       api.frames = frames;
@@ -253,6 +298,8 @@ function start() {
         requestAnimationFrame(() => {
           api.firstFrameMs = performance.now();
           timings.firstFrame = api.firstFrameMs;
+          // The first frame of a large grid was the coarse one: now the full surface.
+          setCoarse(false, 0);
           api.ready = true;
           document.body.dataset.ready = '1';
         });
@@ -385,7 +432,11 @@ function start() {
 
   // For bench/viewer_bench.mjs: renders `n` frames, turning the camera a little about the orbit target each time
   // (as a drag does), each one waited for (a one-pixel read-back); milliseconds per frame.
-  api.timeFrames = (n) => {
+  api.timeFrames = (n, coarse = false) => {
+    if (lod.mesh) {
+      lod.mesh.visible = coarse;
+      fullMesh.visible = !coarse;
+    }
     const gl = renderer.getContext();
     const pixel = new Uint8Array(4);
     const t0 = performance.now();

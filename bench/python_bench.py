@@ -76,20 +76,33 @@ def best_of(n, fn):
     return best
 
 
+def timed(fn):
+    """Wall and CPU seconds (all the process's threads) of fn()."""
+    cpu, wall = time.process_time(), time.perf_counter()
+    fn()
+    return time.perf_counter() - wall, time.process_time() - cpu
+
+
 def overhead(meshes, bunny, runs, bunny_res):
-    print("== Python overhead (C++: the same voxelizeScene calls in a C++ loop; runs alternate C++ and Python, the "
-          "best of %d each)" % runs)
+    print("== Python overhead: the calls against the same voxelizeScene calls in a C++ loop (libvox._voxelize_loop), "
+          "one thread each, runs alternating, the best of %d; wall time, and CPU time (what other jobs on the machine "
+          "change least)" % runs)
     for label, sources, res in [("%d meshes at 32^3" % len(meshes), meshes, 32),
                                 ("bunny (69,451 triangles) at %d^3" % bunny_res, [bunny], bunny_res)]:
         def python_calls():
             for s in sources:
-                libvox.voxelize(s, resolution=res)
+                libvox.voxelize(s, resolution=res, threads=1)
 
-        cpp, py = float("inf"), float("inf")
+        def cpp_loop():
+            libvox._libvox._voxelize_loop(sources, res, threads=1)
+
+        best = {"cpp": [float("inf")] * 2, "py": [float("inf")] * 2}
         for _ in range(runs):  # alternating, so that other jobs on the machine weigh on both alike
-            cpp = min(cpp, libvox._libvox._voxelize_loop(sources, res))
-            py = min(py, best_of(1, python_calls))
-        print(f"{label}: C++ {cpp:.4f} s, Python {py:.4f} s, Python / C++ = {py / cpp:.3f}", flush=True)
+            for name, fn in (("cpp", cpp_loop), ("py", python_calls)):
+                best[name] = [min(a, b) for a, b in zip(best[name], timed(fn))]
+        (cw, cc), (pw, pc) = best["cpp"], best["py"]
+        print(f"{label}: wall C++ {cw:.4f} s, Python {pw:.4f} s, ratio {pw / cw:.3f}; CPU C++ {cc:.4f} s, Python "
+              f"{pc:.4f} s, ratio {pc / cc:.3f}", flush=True)
 
 
 def batch_scaling(meshes, runs):

@@ -20,7 +20,7 @@ double voxelizeLoop(const py::list& sources, uint32_t resolution, const py::obje
   }
   vox::VoxelizeOptions vo;
   vo.resolution = resolution;
-  vo.memoryLimitBytes = vox::memoryBudgetBytes();
+  vo.memoryLimitBytes = memoryBudget();
   Interrupt interrupt;
   return runLong(interrupt, threadsArg(threads), [&] {
     const auto start = std::chrono::steady_clock::now();

@@ -96,6 +96,8 @@ template <class Work>
 auto runLong(Interrupt& interrupt, std::optional<int> threads, Work&& work) -> decltype(work());
 // Helper of runLong: runs `body` in an arena of `threads` threads, or directly.
 void inArena(std::optional<int> threads, const std::function<void()>& body);
+// vox::memoryBudgetBytes(), read once per process as the tools read it (VOX_MEMORY_LIMIT_MB at the first call).
+uint64_t memoryBudget();
 
 template <class Work>
 auto runLong(Interrupt& interrupt, std::optional<int> threads, Work&& work) -> decltype(work()) {

@@ -1,8 +1,11 @@
 // Long calls: the GIL released, worker threads, Ctrl-C and progress (binding.h, Interrupt).
 #include <tbb/task_arena.h>
 
+#include <map>
+
 #include "binding.h"
 #include "vox/core/error.h"
+#include "vox/io/input_file.h"
 
 namespace voxpy {
 
@@ -82,8 +85,17 @@ void inArena(std::optional<int> threads, const std::function<void()>& body) {
     body();
     return;
   }
-  tbb::task_arena arena(*threads);
-  arena.execute(body);
+  // One arena per thread count and per calling thread, kept: making one costs microseconds a call, and an arena
+  // shared by two Python threads would make them take turns.
+  thread_local std::map<int, std::unique_ptr<tbb::task_arena>> arenas;
+  std::unique_ptr<tbb::task_arena>& arena = arenas[*threads];
+  if (!arena) arena = std::make_unique<tbb::task_arena>(*threads);
+  arena->execute(body);
+}
+
+uint64_t memoryBudget() {
+  static const uint64_t budget = vox::memoryBudgetBytes();  // as the tools: read once per process
+  return budget;
 }
 
 }  // namespace voxpy

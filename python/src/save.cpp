@@ -43,7 +43,7 @@ void saveGridSet(const PyGrid& self, const std::string& path, const std::array<u
   vo.bounds = grid.bounds;
   vo.dims = grid.dims;
   vo.method = grid.method;
-  vo.memoryLimitBytes = vox::memoryBudgetBytes();
+  vo.memoryLimitBytes = memoryBudget();
   vo.progress = [&](double f) { return interrupt.poll(0.8 * f); };
   vox::FillOptions fo;
   fo.memoryLimitBytes = vo.memoryLimitBytes;

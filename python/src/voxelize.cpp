@@ -141,7 +141,7 @@ std::shared_ptr<PyGrid> voxelize(const py::object& source, const py::object& res
   }
   const bool doFill = fillArg(fill);
   const auto nThreads = threadsArg(threads);
-  vo.memoryLimitBytes = vox::memoryBudgetBytes();
+  vo.memoryLimitBytes = memoryBudget();
   Interrupt interrupt(progressCallable(progress, "voxelizing"));
   vo.progress = [&](double f) { return interrupt.poll(doFill ? 0.7 * f : f); };
   vox::FillReport report;
@@ -199,7 +199,7 @@ py::object voxelizeBatch(const py::iterable& sources, const py::object& resoluti
   const vox::OverlapMethod m = methodArg(method);
   const bool doFill = fillArg(fill);
   const auto nThreads = threadsArg(threads);
-  const uint64_t budget = vox::memoryBudgetBytes();
+  const uint64_t budget = memoryBudget();
   const uint64_t cube = uint64_t(r) * r * r;
   py::array_t<bool> out;
   bool* cells = nullptr;

@@ -9,7 +9,10 @@
 #include <algorithm>
 #include <cstring>
 #include <map>
+#include <random>
 #include <set>
+
+#include <zlib.h>
 
 #include "test_util.h"
 #include "vox/core/error.h"
@@ -435,6 +438,36 @@ std::string decodeBase64(const std::string& text) {
   return out;
 }
 
+// The data elements of a page: their base64 texts joined and decoded, then inflated (the elements say
+// data-encoding="deflate" and the layout's size in data-bytes). `chunks` counts the elements.
+std::string pageLayout(const std::string& page, size_t& chunks, size_t& firstStart, size_t& lastEnd) {
+  const std::string open = "<script type=\"application/x-vox-data\" data-encoding=\"deflate\" data-bytes=\"";
+  std::string joined;
+  uLong bytes = 0;
+  chunks = 0;
+  firstStart = page.find(open);
+  for (size_t at = firstStart; at != std::string::npos; at = page.find(open, at + 1)) {
+    const size_t tagEnd = page.find("\">", at);
+    bytes = std::stoul(page.substr(at + open.size(), tagEnd - at - open.size()));
+    const size_t close = page.find("</script>", at);
+    const std::string text = page.substr(tagEnd + 2, close - tagEnd - 2);
+    EXPECT_EQ(text.size() % 4, 0u);
+    if (chunks > 0) {
+      EXPECT_EQ(joined.size() % 3, 0u) << "only the last chunk may need padding";
+    }
+    joined += decodeBase64(text);
+    ++chunks;
+    lastEnd = close;
+  }
+  std::string out(bytes, '\0');
+  uLong size = bytes;
+  EXPECT_EQ(uncompress(reinterpret_cast<Bytef*>(out.data()), &size, reinterpret_cast<const Bytef*>(joined.data()),
+                       uLong(joined.size())),
+            Z_OK);
+  EXPECT_EQ(size, bytes);
+  return out;
+}
+
 TEST(ViewerPage, HtmlHoldsTheDataAndTheScript) {
   if (!viewerPageAvailable()) {
     EXPECT_THROW(viewerPageHtml("x", "t"), UsageError);
@@ -446,34 +479,22 @@ TEST(ViewerPage, HtmlHoldsTheDataAndTheScript) {
   const std::string html = viewerPageHtml(data, "a<b>&\"c\".vgrid");
   EXPECT_NE(html.find("<title>a&lt;b&gt;&amp;&quot;c&quot;.vgrid - libvox viewer</title>"), std::string::npos);
   EXPECT_NE(html.find("Content-Security-Policy\" content=\"default-src 'none'"), std::string::npos);
-  const std::string open = "<script type=\"application/x-vox-data\">";
-  const size_t start = html.find(open);
-  ASSERT_NE(start, std::string::npos);
-  const size_t end = html.find("</script>", start);
-  EXPECT_EQ(decodeBase64(html.substr(start + open.size(), end - start - open.size())), data);
+  size_t chunks = 0, start = 0, end = 0;
+  EXPECT_EQ(pageLayout(html, chunks, start, end), data);
+  EXPECT_EQ(chunks, 1u);
   const size_t script = html.find("<script type=\"module\">");
   ASSERT_NE(script, std::string::npos);
+  ASSERT_NE(start, std::string::npos);
   const std::string skeleton = html.substr(0, start) + html.substr(end, script - end);
   for (const char* link : {"src=", "href=", "<link", "url(", "http:", "https:"})
     EXPECT_EQ(skeleton.find(link), std::string::npos) << "nothing to fetch: " << link;
-  // Data of several chunks: each a base64 text of its own, together the data.
+  // Data that does not compress: several chunks, each a base64 text of its own, together the deflated data.
   std::string big(size_t(100) << 20, '\0');
-  for (size_t i = 0; i < big.size(); ++i) big[i] = char(i * 2654435761u >> 13);
+  std::mt19937 rng(7);
+  for (char& c : big) c = char(rng());
   const std::string page = viewerPageHtml(big, "big");
-  std::string joined;
-  size_t chunks = 0;
-  for (size_t at = page.find(open); at != std::string::npos; at = page.find(open, at + 1)) {
-    const size_t close = page.find("</script>", at);
-    const std::string text = page.substr(at + open.size(), close - at - open.size());
-    EXPECT_EQ(text.size() % 4, 0u);
-    if (chunks > 0) {
-      EXPECT_EQ(joined.size() % 3, 0u) << "only the last chunk may need padding";
-    }
-    joined += decodeBase64(text);
-    ++chunks;
-  }
+  EXPECT_TRUE(pageLayout(page, chunks, start, end) == big);
   EXPECT_EQ(chunks, 3u);
-  EXPECT_TRUE(joined == big);
 }
 
 }  // namespace

@@ -4,6 +4,9 @@
 # BUILD/viewer/node_modules (taken from npm's cache when they are there: --prefer-offline); nothing is written into
 # the source tree and nothing built goes into git.
 option(VOX_VIEWER "Build the viewer page of vox-export (-o OUT.html); needs Node.js and npm at build time" ON)
+# The page's data is deflated (zlib, which Debian's OpenVDB and OpenImageIO already bring).
+find_package(ZLIB REQUIRED)
+target_link_libraries(vox PRIVATE ZLIB::ZLIB)
 if(NOT VOX_VIEWER)
   return()
 endif()

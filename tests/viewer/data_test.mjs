@@ -8,8 +8,9 @@ import { pathToFileURL } from 'node:url';
 import { check, finish, info, pageData, scratch, source, tool } from './lib.mjs';
 
 const viewerSrc = (name) => pathToFileURL(join(source, 'viewer', 'src', name)).href;
-const { bytesFromChunks, decodeViewerData, LayoutError } = await import(viewerSrc('data.js'));
+const { decodeViewerData, layoutFromElements, LayoutError } = await import(viewerSrc('data.js'));
 const { Cells } = await import(viewerSrc('cells.js'));
+const { blockSurface } = await import(viewerSrc('lod.js'));
 const { parseHash, formatHash, resolveCamera } = await import(viewerSrc('camera.js'));
 
 const dir = scratch('data');
@@ -25,7 +26,7 @@ for (const g of grids) {
   const grid = join(dir, g.grid);
   const html = join(dir, `${g.grid}.html`);
   tool('vox-export', grid, '-o', html, '--quiet');
-  const d = decodeViewerData(bytesFromChunks(pageData(html)));
+  const d = decodeViewerData(await layoutFromElements(pageData(html)));
   const facts = info(grid, '--cells', '--primitives');
   check(d.dims.join() === facts.dims.join(), `${g.name}: dims ${d.dims}`);
   check(
@@ -94,11 +95,48 @@ for (const g of grids) {
     for (let a = 0; a < 3; ++a) if (d.vertices[3 * v + a] > d.dims[a]) inRange = false;
   for (const t of d.triangles) if (t >= d.vertexCount) inRange = false;
   check(inRange && d.triangleCount > 0, `${g.name}: ${d.triangleCount} surface triangles on the lattice`);
+  // The surface's area (lattice units) is the number of exposed unit squares, which the stand-in of blocks of one
+  // cell draws one by one; blocks of 2 and 3: their exposed faces, counted here cell by cell.
+  let area2 = 0;
+  for (let t = 0; t < d.triangleCount; ++t) {
+    const p = [0, 1, 2].map((c) => [0, 1, 2].map((a) => d.vertices[3 * d.triangles[3 * t + c] + a]));
+    const e1 = p[1].map((x, a) => x - p[0][a]);
+    const e2 = p[2].map((x, a) => x - p[0][a]);
+    area2 += Math.hypot(e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]);
+  }
+  check(blockSurface(cells, 1).faces === area2 / 2, `${g.name}: blocks of 1 cell: ${area2 / 2} exposed squares`);
+  for (const f of [2, 3]) {
+    const n = d.dims.map((x) => Math.ceil(x / f));
+    const full = new Set();
+    for (let k = 0; k < d.dims[2]; ++k)
+      for (let j = 0; j < d.dims[1]; ++j)
+        for (let i = 0; i < d.dims[0]; ++i)
+          if (cells.isVoxel(i, j, k)) full.add(`${Math.floor(i / f)},${Math.floor(j / f)},${Math.floor(k / f)}`);
+    let faces = 0;
+    for (const key of full) {
+      const b = key.split(',').map(Number);
+      for (let a = 0; a < 3; ++a)
+        for (const s of [-1, 1]) {
+          const q = b.slice();
+          q[a] += s;
+          if (q[a] < 0 || q[a] >= n[a] || !full.has(q.join())) ++faces;
+        }
+    }
+    check(blockSurface(cells, f).faces === faces, `${g.name}: blocks of ${f}^3: ${faces} exposed faces`);
+  }
 }
 
 // A damaged layout is refused with a reason, not drawn.
 {
-  const bytes = bytesFromChunks(pageData(join(dir, 'bunny.vgrid.html')));
+  const elements = pageData(join(dir, 'bunny.vgrid.html'));
+  check(elements.length === 1 && elements[0].encoding === 'deflate', 'the page holds its data deflated');
+  const bytes = await layoutFromElements(elements);
+  try {
+    await layoutFromElements([{ ...elements[0], text: elements[0].text.slice(0, elements[0].text.length >> 1) }]);
+    check(false, 'a cut deflated stream: refused');
+  } catch (e) {
+    check(e instanceof LayoutError, `a cut deflated stream: refused (${e.message})`);
+  }
   const expectThrow = (mutate, what) => {
     const copy = bytes.slice();
     const cut = mutate(copy);

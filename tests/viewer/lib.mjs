@@ -50,11 +50,16 @@ export function scratch(tag) {
   return dir;
 }
 
-// The page's bytes of data (what vox-export wrote in its <script type="application/x-vox-data"> elements).
+// The page's data elements as the page reads them ({text, encoding, bytes} of each <script
+// type="application/x-vox-data">), for viewer/src/data.js layoutFromElements.
 export function pageData(htmlPath) {
   const html = readFileSync(htmlPath, 'utf8');
-  const texts = [...html.matchAll(/<script type="application\/x-vox-data">([^<]*)<\/script>/g)].map((m) => m[1]);
-  return texts;
+  const re = /<script type="application\/x-vox-data"([^>]*)>([^<]*)<\/script>/g;
+  return [...html.matchAll(re)].map((m) => ({
+    text: m[2],
+    encoding: /data-encoding="([^"]*)"/.exec(m[1])?.[1],
+    bytes: /data-bytes="([^"]*)"/.exec(m[1])?.[1],
+  }));
 }
 
 export async function launch() {

@@ -18,7 +18,28 @@ export function base64ToBytes(text) {
   return bytes;
 }
 
-// One buffer from the page's <script type="application/x-vox-data"> elements, in document order.
+// The layout from the page's <script type="application/x-vox-data"> elements ({text, encoding, bytes} each, in
+// document order): their base64 texts joined, inflated when the encoding is "deflate" (a zlib stream, as
+// vox-export writes it; DecompressionStream, in every current browser and in Node 18+). Resolves to a Uint8Array.
+export async function layoutFromElements(elements) {
+  const joined = bytesFromChunks(elements.map((e) => e.text));
+  const encoding = elements.length ? elements[0].encoding : '';
+  if (!encoding) return joined;
+  if (encoding !== 'deflate') throw new LayoutError(`viewer data: unknown encoding ${encoding}`);
+  const stream = new Blob([joined]).stream().pipeThrough(new DecompressionStream('deflate'));
+  let out;
+  try {
+    out = new Uint8Array(await new Response(stream).arrayBuffer());
+  } catch (e) {
+    throw new LayoutError(`viewer data: cannot inflate (${e.message})`);
+  }
+  const want = Number(elements[0].bytes);
+  if (elements[0].bytes !== undefined && out.length !== want)
+    throw new LayoutError(`viewer data: ${out.length} bytes inflated, the page says ${want}`);
+  return out;
+}
+
+// One buffer from base64 texts, in order.
 export function bytesFromChunks(texts) {
   const parts = texts.map((t) => base64ToBytes(t.trim()));
   const total = parts.reduce((n, p) => n + p.length, 0);

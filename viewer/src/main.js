@@ -4,7 +4,7 @@
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 
-import { bytesFromChunks, decodeViewerData } from './data.js';
+import { decodeViewerData, layoutFromElements } from './data.js';
 import { formatHash, parseHash, resolveCamera } from './camera.js';
 import { Cells } from './cells.js';
 import { cubes, surfaceMaterial } from './surface.js';
@@ -30,12 +30,16 @@ function fail(message) {
   console.error(`libvox viewer: ${message}`);
 }
 
-function start() {
-  const chunks = [...document.querySelectorAll('script[type="application/x-vox-data"]')].map((s) => s.textContent);
+async function start() {
+  const elements = [...document.querySelectorAll('script[type="application/x-vox-data"]')].map((s) => ({
+    text: s.textContent,
+    encoding: s.dataset.encoding,
+    bytes: s.dataset.bytes,
+  }));
   // Milliseconds since navigation began at each stage, for bench/viewer_bench.mjs.
   const timings = { scriptStart: performance.now() };
   api.timings = timings;
-  const data = decodeViewerData(bytesFromChunks(chunks));
+  const data = decodeViewerData(await layoutFromElements(elements));
   timings.decoded = performance.now();
   api.data = data;
   const cells = new Cells(data);
@@ -86,8 +90,10 @@ function start() {
   // Large surfaces: a coarse stand-in (lod.js) for the first frame and while the camera moves.
   const lod = { mesh: null, factor: 1, coarse: false, timer: 0 };
   api.lod = lod;
-  if (fullMesh && data.triangleCount > LOD_FROM_TRIANGLES) {
-    lod.factor = blockFactor(data.triangleCount, LOD_TRIANGLES);
+  // ?lod=N: the stand-in from N triangles on (tests use a small N).
+  const lodFrom = Number(new URLSearchParams(window.location.search).get('lod') ?? LOD_FROM_TRIANGLES);
+  if (fullMesh && data.triangleCount > lodFrom) {
+    lod.factor = blockFactor(data.triangleCount, Math.min(LOD_TRIANGLES, lodFrom));
     const blocks = blockSurface(cells, lod.factor);
     const g = new THREE.BufferGeometry();
     g.setAttribute('lattice', new THREE.BufferAttribute(blocks.lattice, 3));
@@ -462,8 +468,4 @@ function start() {
   setSlice(-1, 0, true);
 }
 
-try {
-  start();
-} catch (e) {
-  fail(e && e.message ? e.message : String(e));
-}
+start().catch((e) => fail(e && e.message ? e.message : String(e)));

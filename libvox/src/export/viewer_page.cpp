@@ -11,6 +11,8 @@
 #include <type_traits>
 #include <unordered_map>
 
+#include <zlib.h>
+
 #include "vox/core/error.h"
 #include "vox/io/atomic_file.h"
 
@@ -126,6 +128,32 @@ void appendBase64(std::string& out, std::string_view data) {
   }
 }
 
+#ifdef VOX_HAVE_VIEWER_SCRIPT
+// `bytes` as one zlib stream (level 1: three times smaller for a third of the time of level 6 on these layouts).
+std::string deflateBytes(std::string_view bytes) {
+  z_stream z{};
+  if (deflateInit(&z, 1) != Z_OK) fail<LimitError>("viewer page: cannot start zlib");
+  std::string out(deflateBound(&z, uLong(bytes.size())), '\0');
+  z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(bytes.data()));
+  z.next_out = reinterpret_cast<Bytef*>(out.data());
+  // zlib counts in uInt: feed and drain at most 1 GiB at a time.
+  constexpr size_t kStep = size_t(1) << 30;
+  size_t inLeft = bytes.size();
+  int status = Z_OK;
+  while (status == Z_OK) {
+    const size_t in = std::min(inLeft, kStep);
+    z.avail_in = uInt(in);
+    z.avail_out = uInt(std::min(out.size() - z.total_out, kStep));
+    status = deflate(&z, in == inLeft ? Z_FINISH : Z_NO_FLUSH);
+    inLeft -= in - z.avail_in;
+  }
+  deflateEnd(&z);
+  if (status != Z_STREAM_END) fail<LimitError>("viewer page: zlib failed (", status, ")");
+  out.resize(z.total_out);
+  return out;
+}
+#endif
+
 // Bytes of data per <script> element: a multiple of 3 (so each element is base64 on its own), small enough that no
 // browser meets a string-length limit decoding one.
 constexpr size_t kChunkBytes = size_t(48) << 20;
@@ -143,13 +171,16 @@ void emitPage(std::string_view data, const std::string& title, Sink&& sink) {
       "style-src 'unsafe-inline'; img-src data: blob:\">\n"
       "<meta name=\"generator\" content=\"vox-export viewer, data layout " +
       std::to_string(kViewerDataVersion) + "\">\n<title>" + name + " - libvox viewer</title>\n</head>\n<body>\n");
+  // The layout deflated (a zlib stream, RFC 1950; the page inflates it with DecompressionStream): about a third of
+  // its size, which the browser parses three times faster.
+  const std::string packed = deflateBytes(data);
   std::string chunk;
-  for (size_t at = 0; at < data.size() || at == 0; at += kChunkBytes) {
-    chunk = "<script type=\"application/x-vox-data\">";
-    appendBase64(chunk, data.substr(at, kChunkBytes));
+  for (size_t at = 0; at < packed.size(); at += kChunkBytes) {
+    chunk = "<script type=\"application/x-vox-data\" data-encoding=\"deflate\" data-bytes=\"" +
+            std::to_string(data.size()) + "\">";
+    appendBase64(chunk, std::string_view(packed).substr(at, kChunkBytes));
     chunk += "</script>\n";
     sink(std::string_view(chunk));
-    if (data.empty()) break;
   }
   sink("<script type=\"module\">\n");
   sink(std::string_view(viewer_script::kText, viewer_script::kSize));

@@ -5,7 +5,7 @@
 import { writeFileSync } from 'node:fs';
 import { join } from 'node:path';
 
-import { check, finish, info, launch, openPage, scratch, settle, source, tool } from './lib.mjs';
+import { check, coverage, finish, info, launch, openPage, readPng, scratch, settle, source, tool } from './lib.mjs';
 
 const dir = scratch('page');
 const cases = [];
@@ -84,6 +84,41 @@ for (const c of cases) {
   });
   check(true, 'then the full surface');
   check(errors.length === 0, `stand-in: no console error (${errors.join(' | ') || 'none'})`);
+  await context.close();
+}
+
+// The toggles: each layer drawn or not as its box says (pixels that differ from the background, panel hidden).
+{
+  const html = join(dir, 'filled.vgrid.html');
+  const hash = '#eye=0.05,0.25,0.45&look=-0.02,0.1,0.01&up=0,1,0&fov=40';
+  const { page, context, errors } = await openPage(browser, html, { hash, size: [320, 240] });
+  const bg = await page.evaluate(() => window.voxViewer.data.background.map((x) => Math.round(x * 255)));
+  const shot = async () => {
+    await page.evaluate(() => window.voxViewer.setPanelHidden(true));
+    await settle(page);
+    const image = readPng(await page.screenshot({ type: 'png' }));
+    await page.evaluate(() => window.voxViewer.setPanelHidden(false));
+    return image;
+  };
+  const covered = (image) => coverage(image, bg).reduce((n, x) => n + x, 0);
+  const differ = (a, b) => a.data.reduce((n, x, i) => n + (x !== b.data[i] ? 1 : 0), 0);
+  const voxels = await shot();
+  await page.click('#vox-show-lines');
+  const lines = await shot();
+  check(differ(voxels, lines) > 500, `cell lines drawn when on (${differ(voxels, lines)} bytes differ)`);
+  await page.click('#vox-show-lines');
+  await page.click('#vox-show-voxels');
+  await page.click('#vox-show-bounds');
+  const nothing = covered(await shot());
+  check(nothing === 0, `voxels and bounds off: nothing drawn (${nothing} pixels)`);
+  await page.click('#vox-show-triangles');
+  const triangles = covered(await shot());
+  check(triangles > 1000, `the scene's triangles on: ${triangles} pixels`);
+  await page.click('#vox-show-triangles');
+  await page.click('#vox-show-bounds');
+  const bounds = covered(await shot());
+  check(bounds > 100 && bounds < triangles, `the bounds' lines on: ${bounds} pixels`);
+  check(errors.length === 0, `toggles: no console error (${errors.join(' | ') || 'none'})`);
   await context.close();
 }
 

@@ -1,5 +1,5 @@
 // libFuzzer target: every voxel writer (binvox, .vox, .vdb) and the voxel meshes on grids of crafted solid runs and
-// occupied cells, from a grid file or a compact description (fuzz/voxel_writers_entry.h), under a 256 MiB budget.
+// occupied cells, from a grid file or a compact description (fuzz/voxel_writers_entry.h), under a 16 MiB budget.
 #include "voxel_writers_entry.h"
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {

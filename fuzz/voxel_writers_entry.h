@@ -43,12 +43,13 @@
 namespace vox::fuzz {
 
 // The budget the target runs under (VOX_MEMORY_LIMIT_MB unless the environment sets it): small enough that every
-// estimate's refusal is reached, large enough for grids of some thousands of voxels.
-inline constexpr const char* kWriterBudgetMb = "256";
+// estimate's refusal is reached and that what fits is quick under the sanitizers (a .vdb tree of 256 MiB, some
+// 50,000 dense leaves, took 10 s there), large enough for grids of some thousands of voxels.
+inline constexpr const char* kWriterBudgetMb = "16";
 
 // Bytes a writer may send to the sink before the harness stops it: the writers' time past their estimates is their
-// output's (binvox writes a cube of D^3 bits, up to 540 MB at 4096^3), which says nothing new after a few MiB.
-inline constexpr uint64_t kSinkBytes = uint64_t(4) << 20;
+// output's (binvox writes a cube of D^3 bits, up to 540 MB at 4096^3), which says nothing new after a MiB.
+inline constexpr uint64_t kSinkBytes = uint64_t(1) << 20;
 
 // Thrown by the sink when the writer has written kSinkBytes: ends that writer's run without a finding.
 struct SinkFull {};
@@ -188,9 +189,9 @@ void runWriter(const char* writer, F&& write) {
 
 // Every writer on `grid`. The grid's tally (from its runs, without expanding them) decides what is run only where
 // a writer's legitimate work is its output: .vox needs 4 bytes a voxel and the meshes tens, so they run on grids of
-// up to 2^16 voxels, and on larger ones only when their estimates must refuse them (over 2^29 voxels: past .vox's
+// up to 2^14 voxels, and on larger ones only when their estimates must refuse them (over 2^29 voxels: past .vox's
 // 2^31 bytes and the budget), where a hang is a finding; binvox visits every row of its cube twice (up to 2^24), so
-// it runs up to 2^20 rows, and beyond when its dimension must be refused. Grids that break the rules go to every
+// it runs up to 2^16 rows, and beyond when its dimension must be refused. Grids that break the rules go to every
 // writer (each checks the keys and runs before its first row). .vdb always runs: its work is bounded by the runs
 // and its estimate.
 inline void exerciseVoxelWriters(const Grid& grid, const Scene& scene, ColorMode color) {
@@ -202,9 +203,9 @@ inline void exerciseVoxelWriters(const Grid& grid, const Scene& scene, ColorMode
   }
   const uint64_t voxels = tally.voxels;
   const bool invalid = voxels == UINT64_MAX;
-  const bool small = voxels <= (uint64_t(1) << 16);
+  const bool small = voxels <= (uint64_t(1) << 14);
   const bool huge = !invalid && voxels > (uint64_t(1) << 29);
-  if (invalid || tally.rows <= (uint64_t(1) << 20) ||
+  if (invalid || tally.rows <= (uint64_t(1) << 16) ||
       std::max({grid.dims[0], grid.dims[1], grid.dims[2]}) > kBinvoxMaxDim)
     runWriter("binvox", [&] {
       CountingSink sink;

@@ -3,6 +3,7 @@
 
 #include "binding.h"
 #include "vox/core/error.h"
+#include "vox/export/viewer_page.h"
 #include "vox/export/voxel_format.h"
 #include "vox/export/voxel_mesh.h"
 #include "vox/io/atomic_file.h"
@@ -14,10 +15,15 @@ namespace voxpy {
 
 namespace {
 
-bool isGridFilePath(const std::string& path) {
+std::string lowerExtension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return ext == ".vgrid";
+  return ext;
+}
+
+bool isGridFilePath(const std::string& path) { return lowerExtension(path) == ".vgrid"; }
+bool isViewerPagePath(const std::string& path) {
+  return lowerExtension(path) == ".html" || lowerExtension(path) == ".htm";
 }
 
 template <class Parse>
@@ -73,8 +79,9 @@ void save(PyGrid& self, const py::object& pathObj, const std::string& facesName,
   std::vector<std::string> inputs;
   if (self.source() != "<arrays>") inputs.push_back(self.source());
   const auto voxelFormat = vox::voxelFormatFromPath(*path);
-  const bool gridFile = isGridFilePath(*path);
-  if (!gridFile && !voxelFormat) optionArg("path", *path, vox::meshFormatFromPath);
+  const bool gridFile = isGridFilePath(*path), page = isViewerPagePath(*path);
+  if (page && !vox::viewerPageAvailable()) vox::viewerPageHtml({}, {});  // the build's UsageError, before any work
+  if (!gridFile && !voxelFormat && !page) optionArg("path", *path, vox::meshFormatFromPath);
   std::optional<std::array<uint32_t, 3>> bricks;
   if (!bricksArg.is_none()) {
     if (!gridFile) vox::fail<vox::UsageError>("bricks: only a .vgrid output is written as a grid set");
@@ -82,7 +89,7 @@ void save(PyGrid& self, const py::object& pathObj, const std::string& facesName,
     vox::checkBrickCounts(self.grid().dims, *bricks);
   }
   vox::checkOutputPath(*path, inputs);
-  if (!gridFile && !voxelFormat && vox::meshFormatFromPath(*path) == vox::MeshFormat::Obj)
+  if (!gridFile && !voxelFormat && !page && vox::meshFormatFromPath(*path) == vox::MeshFormat::Obj)
     vox::checkOutputPath(std::filesystem::path(*path).replace_extension(".mtl").string(), inputs);
 
   Interrupt interrupt(progressCallable(progress, "saving"));
@@ -96,6 +103,11 @@ void save(PyGrid& self, const py::object& pathObj, const std::string& facesName,
       saveGridSet(self, *path, *bricks, interrupt);
     } else if (gridFile) {
       vox::writeGridFile(*path, self.scene(), grid);
+    } else if (page) {
+      vox::ViewerPageOptions options;
+      options.color = color;
+      options.title = std::filesystem::path(self.source()).filename().string();  // as vox-export: the grid's name
+      vox::writeViewerPage(*path, grid, self.scene(), options);
     } else if (voxelFormat) {
       std::vector<vox::Rgb8> colors;
       if (*voxelFormat == vox::VoxelFormat::MagicaVoxel && color != vox::ColorMode::None)
@@ -129,7 +141,8 @@ Writes the grid in the format of the path's extension, as vox-voxelize and vox-e
       2-manifold) or 'merged' (exposed faces merged into rectangles); color 'count', 'material' or 'none';
       ascii=True for ASCII PLY/STL;
   .binvox (cubic voxels, the corner at bounds[0]), .vox (MagicaVoxel; palette from color), .vdb (OpenVDB grids
-      'density' and 'count').
+      'density' and 'count');
+  .html: vox-export's viewer page (three.js inside, opens from disk), when the build has it.
 Written through a temporary file and a rename: a failure leaves the old file as it was.
 Raises UsageError (unknown extension or option, or the grid's own file as output), OSError (cannot write),
 LimitError (the format cannot hold the grid, e.g. binvox above 4096 a side).

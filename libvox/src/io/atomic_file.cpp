@@ -202,6 +202,7 @@ struct OutputFile::Impl {
   bool committed = false;
   std::string temp;
   int slot = -1;
+  uint64_t flushed = 0;  // bytes whose writeback has been started (write())
   FdStreamBuf buffer{fd};
   std::ostream stream{&buffer};
 };
@@ -276,6 +277,17 @@ void OutputFile::write(std::string_view bytes) {
   VOX_CHECK(!impl_->committed);
   flush();  // bytes given to stream() before come first
   if (const int err = writeAll(impl_->fd, bytes.data(), bytes.size())) failWrite(path_, err);
+  // Starts the kernel's writeback of each further 16 MiB, without waiting for it (SYNC_FILE_RANGE_WRITE only), so
+  // that the disk works while the rest is encoded and commit()'s fsync finds less left to do. Durability is
+  // unchanged: commit() still fsyncs before the rename.
+  constexpr uint64_t kStep = uint64_t(16) << 20;
+  Impl& f = *impl_;
+  if (f.device || bytes.size() == 0) return;
+  const off_t end = ::lseek(f.fd, 0, SEEK_CUR);
+  if (end > 0 && uint64_t(end) - f.flushed >= kStep) {
+    ::sync_file_range(f.fd, off_t(f.flushed), off_t(uint64_t(end) - f.flushed), SYNC_FILE_RANGE_WRITE);
+    f.flushed = uint64_t(end);
+  }
 }
 
 void OutputFile::commit() {
@@ -310,7 +322,10 @@ TemporaryFolder::TemporaryFolder(const std::string& path, bool create) : path_(p
     slot_ = -1;
     fail<OutputError>(path_, ": cannot create the folder: ", std::strerror(err));
   }
+  if (create) syncFolder(path_);  // the files renamed into it are fsynced; its own entry must be too
 }
+
+void syncParentFolder(const std::string& path) { syncFolder(path); }
 
 TemporaryFolder::~TemporaryFolder() {
   if (owner_) {

@@ -40,7 +40,7 @@ std::string randomGeneration() {
 std::unique_ptr<TemporaryFolder> makeGenerationFolder(const std::string& setPath, std::string& folder) {
   const fs::path parent = fs::path(setPath).parent_path() / brickFolderName(setPath);
   std::error_code ec;
-  fs::create_directory(parent, ec);
+  if (fs::create_directory(parent, ec)) syncParentFolder(parent.string());
   if (ec || !fs::is_directory(parent, ec))
     fail<OutputError>(parent.string(), ": cannot create the brick folder",
                       ec ? ": " + ec.message() : std::string(": a file of that name is in the way"));

@@ -72,6 +72,10 @@ class TemporaryFolder {
   bool owner_ = false;
 };
 
+// Makes the entry of `path` in its folder durable (fsync of the folder): after creating a folder whose files an
+// output will name. Best effort, like the folder fsync of OutputFile::commit.
+void syncParentFolder(const std::string& path);
+
 // Writes `bytes` to `path` through an OutputFile (see above).
 // @throw OutputError when the output cannot be written; the old output is then untouched.
 void writeFileAtomically(const std::string& path, std::string_view bytes);

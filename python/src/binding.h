@@ -70,8 +70,9 @@ class Interrupt {
   // From any thread, without the GIL. False once the call should stop.
   bool poll(double fraction);
   bool cancelled() const { return cancelled_.load(std::memory_order_relaxed); }
-  // With the GIL held, after the library call returned or threw: raises the pending Python error, if any.
-  void finish();
+  // With the GIL held, after the library call returned (`completed`) or threw: raises the pending Python error, if
+  // any; else, when completed, reports the fraction 1 to the progress callable.
+  void finish(bool completed = true);
 
  private:
   std::thread::id caller_;
@@ -121,7 +122,7 @@ auto runLong(Interrupt& interrupt, std::optional<int> threads, Work&& work) -> d
   } catch (const py::error_already_set&) {
     throw;
   } catch (...) {
-    interrupt.finish();  // a KeyboardInterrupt replaces the library's "cancelled"
+    interrupt.finish(false);  // a KeyboardInterrupt replaces the library's "cancelled"
     throw;
   }
 }
@@ -158,7 +159,7 @@ py::array_t<T> adoptVector(std::vector<U>&& data, std::vector<py::ssize_t> shape
   return out;
 }
 
-// A read-only numpy view of `count` elements at `data`, owned by `base` (kept alive by the array).
+// A read-only numpy view of the memory at `data`, of `shape`, owned by `base` (which the array keeps alive).
 template <class T>
 py::array_t<T> readOnlyView(const T* data, std::vector<py::ssize_t> shape, py::handle base) {
   py::array_t<T> out(shape, data, base);

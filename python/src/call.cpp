@@ -46,12 +46,12 @@ bool Interrupt::poll(double fraction) {
   return true;
 }
 
-void Interrupt::finish() {
+void Interrupt::finish(bool completed) {
   if (error_) {
     auto error = std::move(error_);
     throw py::error_already_set(std::move(*error));
   }
-  if (!progress_.is_none() && reported_ < 1) {
+  if (completed && !progress_.is_none() && reported_ < 1) {
     reported_ = 1;
     progress_(1.0);
   }

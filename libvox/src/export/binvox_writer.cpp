@@ -72,26 +72,34 @@ class RunEncoder {
   uint64_t count_ = 0;
 };
 
-// Encodes `bits` (the first `nbits` of them, `setBits` of them set) in order.
-void encodePlane(const std::vector<uint64_t>& words, uint64_t nbits, uint64_t setBits, RunEncoder& enc) {
-  if (setBits == 0 || setBits == nbits) return enc.add(setBits != 0, nbits);  // without reading D^2 / 64 words
-  for (size_t w = 0; w < words.size(); ++w) {
-    const unsigned valid = unsigned(std::min<uint64_t>(64, nbits - 64 * w));
+// Encodes the plane `words` (the first `nbits` bits, `setBits` of them set) in order. Only the words in `active`
+// (ascending) are ever set; the others are runs of zeros, added without being read, so a plane costs its active
+// words, not D^2 / 64 (a grid of a few rows in a 4096 cube has thousands of mostly empty planes).
+void encodePlane(const std::vector<uint64_t>& words, uint64_t nbits, uint64_t setBits,
+                 const std::vector<uint32_t>& active, RunEncoder& enc) {
+  if (setBits == 0 || setBits == nbits) return enc.add(setBits != 0, nbits);  // without reading a word
+  uint64_t done = 0;                                                          // bits encoded
+  for (const uint32_t w : active) {
+    const uint64_t start = 64 * uint64_t(w);
+    enc.add(false, start - done);
+    const unsigned valid = unsigned(std::min<uint64_t>(64, nbits - start));
+    done = start + valid;
     uint64_t word = words[w];
     if (word == 0 || (valid == 64 && word == ~uint64_t(0))) {
       enc.add(word != 0, valid);
       continue;
     }
-    unsigned done = 0;
-    while (done < valid) {
+    unsigned used = 0;
+    while (used < valid) {
       const bool bit = word & 1;
       unsigned n = bit ? unsigned(std::countr_one(word)) : unsigned(std::countr_zero(word));
-      n = std::min(n, valid - done);
+      n = std::min(n, valid - used);
       enc.add(bit, n);
-      done += n;
+      used += n;
       word = n >= 64 ? 0 : word >> n;
     }
   }
+  enc.add(false, nbits - done);
 }
 
 }  // namespace
@@ -135,9 +143,9 @@ BinvoxLayout writeBinvox(std::ostream& out, const Grid& plan, const VoxelRowSour
     ++eventStart[r.i0 + r.count + 1];
   });
   for (size_t x = 1; x < eventStart.size(); ++x) eventStart[x] += eventStart[x - 1];
-  requireMemory(
-      saturatingSum({saturatingMul(eventStart.back(), sizeof(uint32_t)), (d + 1) * sizeof(uint64_t), planeBits / 8}),
-      "binvox", "run events and one plane");
+  requireMemory(saturatingSum({saturatingMul(eventStart.back(), sizeof(uint32_t)), (d + 1) * sizeof(uint64_t),
+                               planeBits / 8 + planeBits / 64 * 5}),
+                "binvox", "run events and one plane (with its words' marks and list)");
   std::vector<uint32_t> events(eventStart.back());
   {
     std::vector<uint64_t> fill(eventStart.begin(), eventStart.end() - 1);
@@ -154,7 +162,15 @@ BinvoxLayout writeBinvox(std::ostream& out, const Grid& plan, const VoxelRowSour
                 layout.scale);
   out << header;
   RunEncoder enc(out);
+  // The plane words any event sets (bits j + D k of the rows that hold voxels), ascending.
   std::vector<uint64_t> plane((planeBits + 63) / 64, 0);
+  std::vector<uint32_t> active;
+  {
+    std::vector<uint8_t> marked(plane.size(), 0);  // D^2 / 64 bytes, a quarter of the plane
+    for (const uint32_t bit : events) marked[bit / 64] = 1;
+    for (uint32_t w = 0; w < marked.size(); ++w)
+      if (marked[w]) active.push_back(w);
+  }
   uint64_t setBits = 0;
   for (uint64_t x = 0; x < d; ++x) {
     for (uint64_t e = eventStart[x]; e < eventStart[x + 1]; ++e) {
@@ -163,7 +179,7 @@ BinvoxLayout writeBinvox(std::ostream& out, const Grid& plan, const VoxelRowSour
       word ^= bit;
       setBits = word & bit ? setBits + 1 : setBits - 1;
     }
-    encodePlane(plane, planeBits, setBits, enc);
+    encodePlane(plane, planeBits, setBits, active, enc);
     if (progress && x % 64 == 0) progress(double(x) / double(d));
   }
   enc.finish();

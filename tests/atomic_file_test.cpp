@@ -212,6 +212,37 @@ TEST(AtomicFile, SignalRemovesTheTemporary) {
   }
 }
 
+// A grid set's generation folder (TemporaryFolder): removed with its files by a signal, by destruction without
+// keep(), and kept after keep().
+TEST(AtomicFile, TemporaryFoldersGoWithASignalOrAFailure) {
+  testing::ScratchDir dir("atomic_folder");
+  const std::string folder = dir.file("gen");
+  for (int sig : {SIGINT, SIGTERM}) {
+    const int code = inChild([&] {
+      TemporaryFolder f(folder, true);
+      writeFileAtomically(folder + "/b_0_0_0.vgrid", "brick");
+      OutputFile partial(folder + "/b_1_0_0.vgrid");
+      partial.write("half");
+      ::raise(sig);
+      return 6;  // not reached
+    });
+    EXPECT_EQ(code, 128 + sig);
+    EXPECT_FALSE(std::filesystem::exists(folder));
+  }
+  {
+    TemporaryFolder f(folder, true);
+    writeFileAtomically(folder + "/scene.vgrid", "scene");
+    EXPECT_THROW(TemporaryFolder(folder, true), OutputError);  // a generation folder is always new
+  }
+  EXPECT_FALSE(std::filesystem::exists(folder));
+  {
+    TemporaryFolder f(folder, true);
+    writeFileAtomically(folder + "/scene.vgrid", "scene");
+    f.keep();
+  }
+  EXPECT_TRUE(std::filesystem::exists(folder + "/scene.vgrid"));
+}
+
 // A signal ignored when the process started (nohup, a background job) stays ignored.
 TEST(AtomicFile, IgnoredSignalStaysIgnored) {
   testing::ScratchDir dir("atomic_ignored");

@@ -28,6 +28,12 @@ tool('vox-voxelize', join(source, 'scenes', 'scene5_07_bunny_mesh_1k.txt'), '-o'
 {
   const { c, r } = frame(info(join(dir, 'bunny.vgrid')));
   cases.push({ name: 'bunny, oblique', grid: 'bunny.vgrid', cam: { eye: at(c, r, [1.4, 0.9, 2.4]), look: c, fov: 35 } });
+  // A look point away from the grid's centre (the page once turned to the centre whatever the hash said).
+  cases.push({
+    name: 'bunny, looking past its centre',
+    grid: 'bunny.vgrid',
+    cam: { eye: at(c, r, [0.8, 1.0, 1.5]), look: at(c, r, [0.1, -0.6, 0]), fov: 35 },
+  });
   cases.push({
     name: 'bunny, from above (up along z)',
     grid: 'bunny.vgrid',

@@ -168,8 +168,11 @@ async function start() {
     camera.position.set(...rel(cam.eye));
     camera.lookAt(new THREE.Vector3(...rel(cam.look)));
     if (controls) controls.dispose();
+    // OrbitControls turns the camera to its target (the origin) when made: give it the look point, then look there.
     controls = new OrbitControls(camera, canvas);
     controls.target.set(...rel(cam.look));
+    controls.update();
+    camera.lookAt(controls.target);
     controls.zoomToCursor = true;
     controls.addEventListener('start', () => {
       userMoved = true;

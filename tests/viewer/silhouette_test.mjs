@@ -55,6 +55,12 @@ tool('vox-voxelize', duck, '-o', join(dir, 'duck.vgrid'), '--res', '48', '--quie
   });
 }
 
+// A filled cube seen from near one corner, looking away from it: the near plane must keep the corner (the page once
+// put it at the box's nearest distance, which clipped corners off the view's axis).
+tool('vox-voxelize', join(source, 'tests', 'data', 'unit_cube.obj'), '-o', join(dir, 'cube.vgrid'), '--grid', '8', '8',
+  '8', '--fill', '--quiet');
+cases.push({ name: 'filled cube, near a corner', grid: 'cube.vgrid', cam: { eye: [1.35, 1.3, 1.4], look: [0.1, 0.6, 0.3], fov: 60 } });
+
 // An empty grid: the bunny outside user-given bounds.
 tool('vox-voxelize', join(source, 'scenes', 'bunny_1k.obj'), '-o', join(dir, 'empty.vgrid'), '--bounds', '5', '5',
   '5', '6', '6', '6', '--grid', '4', '4', '4', '--quiet');

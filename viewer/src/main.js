@@ -216,7 +216,7 @@ async function start() {
   }
 
   // Near and far planes that hold the grid and the scene's primitives: near as far as it can go (a little in front
-  // of the closest point of the box), so depth keeps its precision; the eye inside the box gets a near plane of
+  // of the box's nearest depth), so depth keeps its precision; a box reaching behind the eye gets a near plane of
   // 1e-5 of the far one.
   const corner = new THREE.Vector3();
   function fitClipPlanes() {
@@ -236,19 +236,23 @@ async function start() {
       camera.near = 0;
       camera.far = Math.max(far * 1.01, 1e-9);
     } else {
-      const p = camera.position;
+      // Depth along the view direction is linear, so the box's nearest and farthest depths are at its corners.
+      const dir = new THREE.Vector3();
+      camera.getWorldDirection(dir);
       let far = 0;
+      let nearest = Infinity;
       for (let c = 0; c < 8; ++c) {
         corner.set(
           c & 1 ? sceneBox.max.x : sceneBox.min.x,
           c & 2 ? sceneBox.max.y : sceneBox.min.y,
           c & 4 ? sceneBox.max.z : sceneBox.min.z,
         );
-        far = Math.max(far, corner.distanceTo(p));
+        const depth = corner.sub(camera.position).dot(dir);
+        far = Math.max(far, depth);
+        nearest = Math.min(nearest, depth);
       }
       far = Math.max(far * 1.01, 1e-9);
-      const closest = sceneBox.distanceToPoint(p);
-      camera.near = Math.max(closest * 0.99, far * 1e-5);
+      camera.near = Math.max(nearest * 0.99, far * 1e-5);
       camera.far = far;
     }
     camera.updateProjectionMatrix();

@@ -18,6 +18,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "vox/core/error.h"
 #include "vox/core/grid.h"
 #include "vox/core/scene.h"
 #include "vox/io/grid_file.h"
@@ -165,6 +166,17 @@ py::array_t<T> readOnlyView(const T* data, std::vector<py::ssize_t> shape, py::h
   py::array_t<T> out(shape, data, base);
   py::detail::array_proxy(out.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
   return out;
+}
+
+// An option's value parsed by the library's parser (parseFaceMode, parseColorMode, ...), whose InputError becomes a
+// UsageError naming the keyword argument: a bad option is the caller's usage, not a bad file.
+template <class Parse>
+auto optionArg(const char* name, const std::string& value, Parse&& parse) {
+  try {
+    return parse(value);
+  } catch (const vox::InputError& e) {
+    throw vox::UsageError(std::string(name) + ": " + e.what());
+  }
 }
 
 // ---- Registration, one function per file ----

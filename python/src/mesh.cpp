@@ -7,15 +7,6 @@ namespace voxpy {
 
 namespace {
 
-template <class Parse>
-auto optionArg(const char* name, const std::string& value, Parse&& parse) {
-  try {
-    return parse(value);
-  } catch (const vox::InputError& e) {
-    throw vox::UsageError(std::string(name) + ": " + e.what());
-  }
-}
-
 // (n, 4) uint8 RGBA (alpha 255) from 8-bit RGB display colours.
 py::array_t<uint8_t> rgba(const std::vector<vox::Rgb8>& colors) {
   py::array_t<uint8_t> out({py::ssize_t(colors.size()), py::ssize_t(4)});

@@ -26,15 +26,6 @@ bool isViewerPagePath(const std::string& path) {
   return lowerExtension(path) == ".html" || lowerExtension(path) == ".htm";
 }
 
-template <class Parse>
-auto optionArg(const char* name, const std::string& value, Parse&& parse) {
-  try {
-    return parse(value);
-  } catch (const vox::InputError& e) {
-    throw vox::UsageError(std::string(name) + ": " + e.what());
-  }
-}
-
 void warn(const std::string& message) {
   if (PyErr_WarnEx(PyExc_UserWarning, message.c_str(), 1) != 0) throw py::error_already_set();
 }

@@ -53,7 +53,7 @@ struct Layout {
   std::vector<T> takeAs(size_t count) {
     EXPECT_EQ(at % 8, 0u);
     std::vector<T> out(count);
-    std::memcpy(out.data(), bytes.data() + at, count * sizeof(T));
+    if (count > 0) std::memcpy(out.data(), bytes.data() + at, count * sizeof(T));  // an empty vector's data() is null
     at = (at + count * sizeof(T) + 7) / 8 * 8;
     EXPECT_LE(at, bytes.size());
     return out;

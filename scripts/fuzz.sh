@@ -170,7 +170,13 @@ seed voxel_writers "$root"/tests/data/fuzz/voxel_writers/* "$m"/all.vgrid "$m"/c
 # leak-*, timeout-* or oom-* files.
 fuzz_one() {
   local t=$1 code=0
-  "$build/fuzz/fuzz_$t" "$run/$t/corpus" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+  # The voxel writers' target runs every writer on each input (8 runs a second under the sanitizers): a mutated
+  # input once took 21 s there (OpenVDB's tree and the meshes of a grid inside the harness's budget), which is slow,
+  # not hung; its limit is wider so that CI's short run does not fail on such a unit (issue 23's note).
+  local limits="-timeout=10"
+  [ "$t" = voxel_writers ] && limits="-timeout=60 -report_slow_units=120"
+  # shellcheck disable=SC2086
+  "$build/fuzz/fuzz_$t" "$run/$t/corpus" -max_total_time="$seconds" $limits -rss_limit_mb=2048 \
     -max_len="${max_len[$t]}" -artifact_prefix="$run/$t/artifacts/" -print_final_stats=1 >"$run/$t.log" 2>&1 || code=$?
   echo "$code" >"$run/$t.code"
 }

@@ -341,12 +341,6 @@ void TemporaryFolder::keep() {
   owner_ = false;
 }
 
-void TemporaryFolder::discard() {
-  std::error_code ec;
-  std::filesystem::remove_all(path_, ec);
-  keep();
-}
-
 void writeFileAtomically(const std::string& path, std::string_view bytes) {
   OutputFile out(path);
   out.write(bytes);

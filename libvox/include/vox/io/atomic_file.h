@@ -62,8 +62,6 @@ class TemporaryFolder {
 
   // The folder stays: it is no longer removed on destruction or signal.
   void keep();
-  // Removes the folder and its files now (the files of an abandoned output), and unregisters it.
-  void discard();
   const std::string& path() const { return path_; }
 
  private:

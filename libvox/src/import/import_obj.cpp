@@ -22,6 +22,7 @@
 #include "import/obj_reader.h"
 #include "import/texture_decode.h"
 #include "vox/core/error.h"
+#include "vox/core/huge_pages.h"
 #include "vox/import/import.h"
 #include "vox/io/input_file.h"
 
@@ -130,7 +131,7 @@ Scene importObj(const std::string& path) {
   const bool textured = !scene.textures.empty();
   checkMemory(double(obj.triangles.size()) * (sizeof(Triangle) + (textured ? sizeof(std::array<TexCoord, 3>) : 0)),
               path, "making " + std::to_string(obj.triangles.size()) + " triangles");
-  scene.triangles.reserve(obj.triangles.size());
+  reserveOnHugePages(scene.triangles, obj.triangles.size());
   std::vector<Material> clones;  // untextured copies, materials defaultMaterial + 1 + k
   std::map<uint32_t, uint32_t> cloneOf;
   bool warnedNoTexcoords = false;

@@ -31,6 +31,7 @@
 
 #include "import/obj_reader.h"
 #include "vox/core/error.h"
+#include "vox/core/huge_pages.h"
 #include "vox/import/import.h"
 
 namespace vox {
@@ -390,9 +391,9 @@ PlyMesh readBody(Cursor in, const PlyHeader& h) {
   size_t vertexCount = 0;
   for (const PlyElement& e : h.elements) {
     if (e.name == "vertex") vertexCount = static_cast<size_t>(e.count);
-    if (e.name == "face") out.triangles.reserve(static_cast<size_t>(e.count));
+    if (e.name == "face") reserveOnHugePages(out.triangles, static_cast<size_t>(e.count));
   }
-  out.vertices.reserve(vertexCount);
+  reserveOnHugePages(out.vertices, vertexCount);
   for (const PlyElement& e : h.elements) readElement(in, e, vertexCount, out);
   return out;
 }
@@ -409,7 +410,7 @@ Scene importPly(const std::string& path) {
 
   Scene scene;
   scene.materials.push_back(Material{"default"});
-  scene.triangles.reserve(mesh.triangles.size());
+  reserveOnHugePages(scene.triangles, mesh.triangles.size());
   for (const auto& f : mesh.triangles)
     scene.triangles.push_back({{mesh.vertices[f[0]], mesh.vertices[f[1]], mesh.vertices[f[2]]}, 0});
   if (mesh.shortFaces > 0)

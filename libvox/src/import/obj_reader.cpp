@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "vox/core/error.h"
+#include "vox/core/huge_pages.h"
 #include "vox/io/input_file.h"
 
 namespace vox {
@@ -161,6 +162,7 @@ class ObjParser {
       double ignored = 0;
       if (!parseNumber(w, ignored)) failAt(line, "bad number ", quotedWord(w));
     }
+    growOnHugePages(data_.vertices);
     data_.vertices.push_back({xyz[0], xyz[1], xyz[2]});
   }
 
@@ -239,6 +241,8 @@ class ObjParser {
     }
     if (polygon_.size() < 3) failAt(line, "face needs at least 3 vertices");
     for (size_t k = 1; k + 1 < polygon_.size(); ++k) {
+      growOnHugePages(data_.triangles);
+      growOnHugePages(data_.triangleMaterial);
       data_.triangles.push_back({polygon_[0], polygon_[k], polygon_[k + 1]});
       data_.triangleMaterial.push_back(currentMaterial_);
       if (textured) {

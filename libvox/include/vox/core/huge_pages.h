@@ -3,6 +3,7 @@
 // written once front to back) otherwise spend a fifth of their time in 4 KiB page faults (docs/voxelize-speed.md).
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <vector>
 
@@ -18,6 +19,14 @@ template <typename T>
 void reserveOnHugePages(std::vector<T>& v, size_t n) {
   v.reserve(n);
   adviseHugePages(v.data() + v.size(), (v.capacity() - v.size()) * sizeof(T));
+}
+
+// Before a push_back onto an array that may grow large: when it is full, doubles its capacity on huge pages, so
+// that a reader growing its arrays one element at a time (an OBJ's vertices and faces) does not fault them in
+// 4 KiB at a time.
+template <typename T>
+void growOnHugePages(std::vector<T>& v) {
+  if (v.size() == v.capacity()) reserveOnHugePages(v, std::max<size_t>(v.capacity() * 2, 1024));
 }
 
 }  // namespace vox

@@ -1,0 +1,85 @@
+// The huge-page requests change speed only: arrays keep their contents through every reservation and growth step,
+// and a mesh large enough to cross many growth steps reads back bit for bit (issue 26).
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "import/obj_reader.h"
+#include "vox/core/huge_pages.h"
+
+namespace vox {
+namespace {
+
+TEST(HugePages, ReserveKeepsContentsAndGrowsCapacity) {
+  std::vector<uint64_t> v;
+  for (uint64_t i = 0; i < 1000; ++i) v.push_back(i * 2654435761u);
+  reserveOnHugePages(v, size_t{3} << 20);  // 24 MiB: several whole huge pages
+  ASSERT_GE(v.capacity(), size_t{3} << 20);
+  ASSERT_EQ(v.size(), 1000u);
+  for (uint64_t i = 0; i < 1000; ++i) ASSERT_EQ(v[i], i * 2654435761u);
+  reserveOnHugePages(v, 10);  // never shrinks
+  EXPECT_GE(v.capacity(), size_t{3} << 20);
+}
+
+TEST(HugePages, GrowDoublesOnlyWhenFull) {
+  std::vector<uint32_t> v;
+  growOnHugePages(v);
+  EXPECT_GE(v.capacity(), 1024u);
+  const size_t first = v.capacity();
+  v.push_back(7);
+  growOnHugePages(v);
+  EXPECT_EQ(v.capacity(), first);  // not full: untouched
+  v.resize(v.capacity(), 9);
+  growOnHugePages(v);
+  EXPECT_EQ(v.capacity(), 2 * first);
+  EXPECT_EQ(v[0], 7u);
+  EXPECT_EQ(v.back(), 9u);
+}
+
+TEST(HugePages, AdviceOnSmallOrNullRangesIsHarmless) {
+  adviseHugePages(nullptr, size_t{1} << 30);
+  const char small[16] = {};
+  adviseHugePages(small, sizeof small);
+  SUCCEED();
+}
+
+// 300,000 vertices and faces (about 20 growth steps of each array) read back exactly as written.
+TEST(HugePages, LargeObjReadsBackBitForBit) {
+  std::mt19937_64 random(26);
+  std::uniform_real_distribution<double> coordinate(-1e3, 1e3);
+  constexpr size_t kVertices = 300000;
+  std::vector<double> written(3 * kVertices);
+  std::string text;
+  text.reserve(kVertices * 90);
+  char line[128];
+  for (size_t i = 0; i < kVertices; ++i) {
+    for (int k = 0; k < 3; ++k) written[3 * i + size_t(k)] = coordinate(random);
+    std::snprintf(line, sizeof line, "v %.17g %.17g %.17g\n", written[3 * i], written[3 * i + 1], written[3 * i + 2]);
+    text += line;
+  }
+  for (size_t i = 0; i + 2 < kVertices; ++i) {
+    std::snprintf(line, sizeof line, "f %zu %zu -1\n", i + 1, i + 2);
+    text += line;
+  }
+  const ObjData obj = parseObj(text, "large.obj");
+  ASSERT_EQ(obj.vertices.size(), kVertices);
+  ASSERT_EQ(obj.triangles.size(), kVertices - 2);
+  ASSERT_EQ(obj.triangleMaterial.size(), kVertices - 2);
+  for (size_t i = 0; i < kVertices; ++i) {
+    const double got[3] = {obj.vertices[i].x, obj.vertices[i].y, obj.vertices[i].z};
+    ASSERT_EQ(std::memcmp(got, &written[3 * i], sizeof got), 0) << "vertex " << i;
+  }
+  for (size_t i = 0; i + 2 < kVertices; ++i) {
+    ASSERT_EQ(obj.triangles[i][0], i);
+    ASSERT_EQ(obj.triangles[i][1], i + 1);
+    ASSERT_EQ(obj.triangles[i][2], kVertices - 1);  // -1: the last vertex read, all are read before the faces
+  }
+}
+
+}  // namespace
+}  // namespace vox

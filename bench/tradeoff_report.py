@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
-"""Turns the tradeoff CSV into docs/tradeoff.md and two gnuplot PNG plots.
+"""Turns the tradeoff CSV into docs/tradeoff.md and two matplotlib PNG plots (docs/images/tradeoff_*.png, their
+data written beside them as .dat files).
 Usage: tradeoff_report.py CSV SAT_SEARCH_TXT DOCS_DIR THREADS"""
 import csv
 import os
-import subprocess
+import math
 import sys
 from collections import defaultdict
 
@@ -24,55 +25,115 @@ exact_refs = {(r["scene"], r["res"]): r["references"] for r in rows if r["method
 # The default-heuristic rows repeat a sweep point's kind of data; plots use the sweep only.
 sweep = [r for r in rows if r["res"] > 0]
 data1 = os.path.join(images, "tradeoff_error.dat")
+points1 = {m: [] for m in methods}
 with open(data1, "w") as f:
+    f.write("# voxelize seconds, (references added + missed) / exact references (0 = none), per method; "
+            "from docs/tradeoff.csv by bench/tradeoff_report.py\n")
     for m in methods:
         f.write(f'"{m}"\n')
         for r in sweep:
             if r["method"] != m:
                 continue
             err = (r["refs_added"] + r["refs_missed"]) / max(1, exact_refs[(r["scene"], r["res"])])
-            f.write(f'{r["voxelize_s"]:.6g} {max(err, 1e-6):.6g}\n')
+            points1[m].append((r["voxelize_s"], err))
+            f.write(f'{r["voxelize_s"]:.6g} {err:.6g}\n')
         f.write("\n\n")
-# Plot 2: shaded-image trace time against occupied-cell references per primitive, exact grids, per scene.
+# Plot 2: shaded-image trace time against grid cells per primitive, exact grids, per scene.
 data2 = os.path.join(images, "tradeoff_trace.dat")
+points2 = {s: [] for s in scenes}
+defaults2 = {}
 with open(data2, "w") as f:
+    f.write("# grid cells per primitive, shaded-image trace seconds, exact grids, per scene; "
+            "from docs/tradeoff.csv by bench/tradeoff_report.py\n")
     for s in scenes:
         f.write(f'"{s}"\n')
         for r in sweep:
             if r["scene"] == s and r["method"] == "exact":
                 cells = r["nx"] * r["ny"] * r["nz"]
+                points2[s].append((cells / max(1, r["primitives"]), r["shade_s"]))
                 f.write(f'{cells / max(1, r["primitives"]):.6g} {r["shade_s"]:.6g}\n')
         f.write("\n\n")
-script = f"""
-set terminal pngcairo size 900,600 noenhanced
-set output '{images}/tradeoff_error.png'
-set logscale xy
-set xlabel 'voxelize seconds'
-set ylabel 'references added + missed / exact references (1e-6 = none)'
-set key outside
-plot for [i=0:{len(methods)-1}] '{data1}' index i using 1:2 with points pt 7 title columnheader(1)
-set output '{images}/tradeoff_trace.png'
-set xlabel 'grid cells per primitive'
-set ylabel 'trace seconds (shaded image, primary + shadow rays)'
-plot for [i=0:{len(scenes)-1}] '{data2}' index i using 1:2 with linespoints title columnheader(1)
-"""
+        for r in rows:
+            if r["scene"] == s and r["method"] == "exact" and r["res"] == 0:
+                defaults2[s] = (r["nx"] * r["ny"] * r["nz"] / max(1, r["primitives"]), r["shade_s"])
+
+
+def draw_plots():
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import plot_style as ps
+
+    footnote = (f"bench/tradeoff.sh ({threads} threads, 256x256 shaded image); data: docs/tradeoff.csv, "
+                "docs/images/tradeoff_*.dat; redraw: python3 bench/tradeoff_report.py docs/tradeoff.csv "
+                f"docs/sat_search.txt docs {threads}")
+    # Plot 1.
+    fig, ax = ps.figure(5.0)
+    errors = [e for m in methods for _, e in points1[m] if e > 0]
+    floor = 10 ** (math.floor(math.log10(min(errors))) - 1) if errors else 1e-6
+    styles = {"exact": ("o", 60, "#1f77b4"), "sat": ("x", 40, "#d62728"), "bbox": ("s", 30, "#2ca02c"),
+              "center": ("^", 30, "#9467bd")}
+    for m in methods:
+        marker, size, colour = styles[m]
+        xs = [t for t, _ in points1[m]]
+        ys = [e if e > 0 else floor for _, e in points1[m]]
+        wrong = sum(1 for _, e in points1[m] if e > 0)
+        filled = {"facecolors": "none", "edgecolors": colour} if marker in ("o", "s", "^") else {"color": colour}
+        ax.scatter(xs, ys, s=size, marker=marker, **filled,
+                   label=f"{m}: {wrong} of {len(xs)} grids differ from exact")
+    ps.log_axis(ax, "x")
+    ps.log_axis(ax, "y", zero_at=floor)
+    ax.set_ylim(floor / 2.5, None)
+    ax.set_xlabel("voxelize time (s, voxelization alone, per scene and resolution)")
+    ax.set_ylabel("references added + missed / exact's references")
+    ax.set_title("Overlap methods: voxelize time against error, 9 scenes x 6 resolutions")
+    ax.legend(loc="upper left")
+    ps.footnote(fig, footnote)
+    fig.tight_layout(rect=(0, 0.03, 1, 1))
+    ps.save(fig, os.path.join(images, "tradeoff_error.png"))
+    # Plot 2.
+    fig, ax = ps.figure(5.2)
+    cmap = ps.plt.get_cmap("tab10")
+    for i, s in enumerate(scenes):
+        pts = sorted(points2[s])
+        ax.plot([c for c, _ in pts], [t for _, t in pts], marker="o", markersize=4, color=cmap(i % 10), label=s)
+        if s in defaults2:
+            ax.scatter([defaults2[s][0]], [defaults2[s][1]], marker="*", s=130, color=cmap(i % 10),
+                       edgecolors="black", linewidths=0.6, zorder=3)
+    ax.scatter([], [], marker="*", s=130, color="white", edgecolors="black", label="default grid (vox-voxelize)")
+    ps.log_axis(ax, "x")
+    ps.log_axis(ax, "y")
+    ax.set_xlabel("grid cells per primitive (cells / primitives)")
+    ax.set_ylabel("trace time (s, 256x256 shaded image)")
+    ax.set_title("Exact grids: trace time against grid resolution, per scene")
+    ax.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), fontsize=7.5)
+    ps.footnote(fig, footnote)
+    fig.tight_layout(rect=(0, 0.03, 1, 1))
+    ps.save(fig, os.path.join(images, "tradeoff_trace.png"))
+
+
 try:
-    subprocess.run(["gnuplot"], input=script, text=True, check=True)
+    draw_plots()
     plots = True
-except (OSError, subprocess.CalledProcessError) as e:
-    print(f"tradeoff_report: no plots ({e})", file=sys.stderr)
+except ImportError as e:
+    print(f"tradeoff_report: no plots ({e}; Debian: python3-matplotlib)", file=sys.stderr)
     plots = False
 
 out = []
 out.append("# Speed and accuracy: overlap methods and grid resolution\n")
+out.append("What this page is for: which overlap method and grid resolution to pick, from the cost and the error of "
+           "each measured on 9 scenes at 6 resolutions (generated by `bench/tradeoff_report.py`; edit that, not "
+           "this page).\n")
 out.append("Measured by `bench/tradeoff.sh` (build with `-DVOX_BENCH=ON`), on this project's 2-core machine with "
            f"{threads} threads; raw numbers in `docs/tradeoff.csv`. Voxelize times are of voxelization alone (in "
            "process, no file I/O); trace times are of a shaded image (primary and shadow rays) through the grid. "
            "`added`/`missed` count (cell, primitive) references relative to `exact`; `px diff` counts pixels of the "
            "shaded image that differ from the brute-force image (no grid).\n")
 if plots:
-    out.append("![time against error](images/tradeoff_error.png)\n")
-    out.append("![trace time against cells per primitive](images/tradeoff_trace.png)\n")
+    out.append("Both plots are redrawn from the stored numbers, without measuring again, by "
+               f"`python3 bench/tradeoff_report.py docs/tradeoff.csv docs/sat_search.txt docs {threads}` "
+               "(their data: `docs/images/tradeoff_error.dat`, `tradeoff_trace.dat`); `bash bench/tradeoff.sh` "
+               "measures again and redraws.\n")
+    out.append("![Overlap methods: voxelize time against error](images/tradeoff_error.png)\n")
+    out.append("![Exact grids: trace time against grid resolution, per scene](images/tradeoff_trace.png)\n")
 for s in scenes:
     srows = [r for r in rows if r["scene"] == s]
     out.append(f"\n## {s} ({srows[0]['primitives']} primitives)\n")

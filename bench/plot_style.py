@@ -1,5 +1,7 @@
 """The house style of the bench plots (matplotlib, Debian's python3-matplotlib): 800 pixels wide, log axes labelled
 in powers of ten, a grey footnote saying where and how the numbers were measured."""
+import math
+
 import matplotlib
 
 matplotlib.use("Agg")
@@ -26,7 +28,14 @@ def log_axis(ax, which, zero_at=None):
     set_scale("log")
     axis.set_major_locator(LogLocator(base=10, numticks=15))
     axis.set_minor_locator(LogLocator(base=10, subs=range(2, 10), numticks=15))
-    axis.set_minor_formatter(LogFormatterSciNotation(labelOnlyBase=False, minor_thresholds=(2, 0.5)))
+    def minor(v, pos):  # 2x10^k and 5x10^k, only on an axis of fewer than 2.6 decades
+        lo, hi = sorted(axis.get_view_interval())
+        k = math.floor(math.log10(v) + 1e-9)
+        mantissa = round(v / 10**k)
+        if lo <= 0 or math.log10(hi / lo) > 2.6 or mantissa not in (2, 5):
+            return ""
+        return f"${mantissa}\\times10^{{{k}}}$"
+    axis.set_minor_formatter(FuncFormatter(minor))
     mathtext = LogFormatterSciNotation()
     if zero_at is None:
         axis.set_major_formatter(mathtext)

@@ -2,7 +2,10 @@
 in powers of ten, a grey footnote saying where and how the numbers were measured."""
 import math
 
-import matplotlib
+try:
+    import matplotlib
+except ImportError as e:  # pyenv's or a venv's python3 earlier on PATH has no Debian packages
+    raise ImportError("matplotlib not found: apt-get install python3-matplotlib, and run with /usr/bin/python3") from e
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402

@@ -100,14 +100,13 @@ def load_csv():
 
 
 def plot():
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import plot_style as ps
 
     rows, comments = load_csv()
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     kinds = [k for k in KINDS if any(r["ray_kind"] == k for r in rows)]
-    fig, ax = plt.subplots(figsize=(8, 4.8), dpi=100)
+    fig, ax = ps.figure(4.8)
     width = 0.8 / len(scenes)
     colours = ["#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd"]
     for s, scene in enumerate(scenes):
@@ -122,6 +121,7 @@ def plot():
     ax.text(-0.45, 1.02, "Embree = 1", ha="left", va="bottom", fontsize=9)
     ax.set_xticks(range(len(kinds)))
     ax.set_xticklabels(kinds, fontsize=10)
+    ax.grid(axis="x", visible=False)
     ax.set_ylabel("rays per second, ours / Embree 3 (ratio)")
     ax.set_xlabel("ray kind (one ray at a time unless 'packets'; 1 thread)")
     ax.set_ylim(0, max(1.25, max(float(r["ours_over_embree"]) for r in rows) * 1.15))
@@ -133,8 +133,7 @@ def plot():
                  + "\nbench/trace_plot.py runs build/bench/bench_trace; data: docs/images/trace_vs_embree.csv, .txt",
                  fontsize=7, color="#555555")
     fig.tight_layout(rect=(0, 0.05, 1, 1))
-    fig.savefig(PNG)
-    print(f"wrote {PNG}")
+    ps.save(fig, PNG)
 
 
 def main():

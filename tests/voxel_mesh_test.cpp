@@ -12,7 +12,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
-#include "vox/export/colormap.h"
+#include "vox/core/colormap.h"
 #include "vox/core/error.h"
 #include "vox/export/voxel_mesh.h"
 

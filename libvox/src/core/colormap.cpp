@@ -1,4 +1,4 @@
-#include "vox/export/colormap.h"
+#include "vox/core/colormap.h"
 
 #include <algorithm>
 #include <array>
@@ -34,6 +34,17 @@ Vec3 countColor(uint32_t count, uint32_t maxCount) {
   if (count <= 1 || maxCount <= 1) return viridis(0);
   if (count >= maxCount) return viridis(1);
   return viridis(std::log(double(count)) / std::log(double(maxCount)));
+}
+
+Vec3 heatColor(double value, double maxValue) {
+  double x = maxValue > 0 ? value / maxValue : 0;
+  x = std::clamp(x, 0.0, 1.0);
+  // Piecewise-linear ramp: black-blue, blue, red, yellow, white.
+  static const Vec3 stops[] = {{0, 0, 0.15}, {0.1, 0.2, 0.9}, {0.9, 0.1, 0.1}, {1, 0.85, 0}, {1, 1, 1}};
+  const double f = x * 4;
+  const int i = std::min(3, int(f));
+  const double w = f - i;
+  return stops[i] * (1 - w) + stops[i + 1] * w;
 }
 
 }  // namespace vox

@@ -13,7 +13,7 @@
 #include <mutex>
 
 #include "vox/export/cell_color.h"
-#include "vox/export/colormap.h"
+#include "vox/core/colormap.h"
 #include "export/export_budget.h"
 #include "export/voxel_surface.h"
 #include "vox/core/checked_math.h"

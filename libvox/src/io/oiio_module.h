@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "vox/trace/render.h"
+#include "vox/core/image.h"
 
 namespace vox {
 

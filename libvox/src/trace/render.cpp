@@ -9,15 +9,11 @@
 #include <chrono>
 #include <cmath>
 
-#include "vox/core/error.h"
 #include "trace/pixel_filter.h"
 #include "trace/shade.h"
+#include "vox/core/colormap.h"
+#include "vox/core/error.h"
 #include "vox/trace/trace_packet.h"
-
-#if __has_include("vox/colormap.h")
-#include "vox/export/colormap.h"
-#define VOX_HAVE_COLORMAP 1
-#endif
 
 namespace vox {
 
@@ -30,26 +26,11 @@ RenderMode parseRenderMode(const std::string& name) {
   fail<UsageError>("unknown mode '", name, "' (expected shade, voxels, count, normals or depth)");
 }
 
-Vec3 heatColor(double value, double maxValue) {
-  double x = maxValue > 0 ? value / maxValue : 0;
-  x = std::clamp(x, 0.0, 1.0);
-  // Piecewise-linear ramp: black-blue, blue, red, yellow, white.
-  static const Vec3 stops[] = {{0, 0, 0.15}, {0.1, 0.2, 0.9}, {0.9, 0.1, 0.1}, {1, 0.85, 0}, {1, 1, 1}};
-  const double f = x * 4;
-  const int i = std::min(3, int(f));
-  const double w = f - i;
-  return stops[i] * (1 - w) + stops[i + 1] * w;
-}
-
 namespace {
 
+// The heat ramp, starting above black so that one-primitive cells show.
 Vec3 voxelColor(uint32_t count, uint32_t maxCount) {
-#ifdef VOX_HAVE_COLORMAP
-  return countColor(count, maxCount);
-#else
-  // Fallback until colormap.h exists: the heat ramp above, starting above black so one-primitive cells show.
   return heatColor(0.25 + 0.75 * double(count) / double(std::max<uint32_t>(maxCount, 1)), 1.0);
-#endif
 }
 
 struct Frame {

@@ -1,5 +1,6 @@
-// The colour map for primitive counts, shared by `vox-trace --mode voxels` and `vox-export --color count`, so that
-// a cell has the same colour in the image and in the exported mesh.
+// The colour maps: for primitive counts, shared by `vox-trace --mode voxels` and `vox-export --color count` so that a
+// cell has the same colour in the image and in the exported mesh, and the heat map of `vox-trace --mode count`.
+// In core because the renderer and the exporters both use them and neither may include the other.
 #pragma once
 
 #include <cstdint>
@@ -17,5 +18,8 @@ Vec3 countColor(uint32_t count, uint32_t maxCount);
 
 // viridis at t in [0, 1] (clamped), piecewise linear through nine samples of matplotlib's table.
 Vec3 viridis(double t);
+
+// Heat colour of value / maxValue in [0, 1] (dark blue, through red, to white) for the count mode.
+Vec3 heatColor(double value, double maxValue);
 
 }  // namespace vox

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "vox/trace/render.h"
+#include "vox/core/image.h"
 
 namespace vox {
 

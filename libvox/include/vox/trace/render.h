@@ -6,9 +6,10 @@
 #include <string>
 #include <vector>
 
+#include "vox/core/image.h"
+#include "vox/core/scene.h"
 #include "vox/trace/accel.h"
 #include "vox/trace/ray.h"
-#include "vox/core/scene.h"
 #include "vox/trace/traverse.h"
 
 namespace vox {
@@ -16,15 +17,6 @@ namespace vox {
 enum class RenderMode : uint8_t { Shade, Voxels, Count, Normals, Depth };
 // Throws UsageError for a name other than shade, voxels, count, normals, depth.
 RenderMode parseRenderMode(const std::string& name);
-
-// A float image, rows from the top, pixels interleaved: pixels[(y * width + x) * channels + c].
-struct Image {
-  uint32_t width = 0, height = 0, channels = 3;
-  std::vector<float> pixels;
-
-  float* at(uint32_t x, uint32_t y) { return pixels.data() + (uint64_t(y) * width + x) * channels; }
-  const float* at(uint32_t x, uint32_t y) const { return pixels.data() + (uint64_t(y) * width + x) * channels; }
-};
 
 // Reconstruction filters of the course's assignment 7: a pixel is the weighted mean of the samples (its own and
 // its neighbours') within the filter's support around its centre; d is the distance in pixels, r the radius.
@@ -78,8 +70,5 @@ Image traceImage(const Scene& scene, const Accel& accel, const RenderOptions& op
 
 // The depth image as grey for 8-bit formats, linear in 1/depth: the nearest hit 1, the farthest 0.15, nothing hit 0.
 Image depthToGrey(const Image& depth);
-
-// Heat colour of value / maxValue in [0, 1] (dark blue, through red, to white) for the count mode.
-Vec3 heatColor(double value, double maxValue);
 
 }  // namespace vox

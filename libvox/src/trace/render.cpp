@@ -28,10 +28,8 @@ RenderMode parseRenderMode(const std::string& name) {
 
 namespace {
 
-// The heat ramp, starting above black so that one-primitive cells show.
-Vec3 voxelColor(uint32_t count, uint32_t maxCount) {
-  return heatColor(0.25 + 0.75 * double(count) / double(std::max<uint32_t>(maxCount, 1)), 1.0);
-}
+// The colour of a cell by its primitive count: vox-export --color count's, so a cell looks alike in both.
+Vec3 voxelColor(uint32_t count, uint32_t maxCount) { return countColor(count, maxCount); }
 
 struct Frame {
   Vec3 dir, right, up;

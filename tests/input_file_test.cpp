@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "voxelize/cell_range.h"
+#include "vox/core/cell_range.h"
 #include "vox/core/error.h"
 
 namespace vox {

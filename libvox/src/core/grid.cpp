@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "voxelize/cell_range.h"
+#include "vox/core/cell_range.h"
 #include "vox/core/error.h"
 
 namespace vox {

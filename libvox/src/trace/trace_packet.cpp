@@ -16,7 +16,7 @@
 #include <cmath>
 #include <limits>
 
-#include "voxelize/cell_range.h"
+#include "vox/core/cell_range.h"
 #include "trace/mailbox.h"
 #include "trace/triangle_kernel.h"
 #include "vox/core/error.h"

@@ -12,7 +12,7 @@
 #include <cmath>
 #include <span>
 
-#include "voxelize/cell_range.h"
+#include "vox/core/cell_range.h"
 #include "vox/core/huge_pages.h"
 #include "voxelize/radix_sort.h"
 #include "voxelize/triangle_filter.h"

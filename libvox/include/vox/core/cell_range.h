@@ -1,6 +1,7 @@
 // The cells of one axis whose closed boxes meet [lo, hi], for any way of getting the boundaries b(0..n): from the
 // formula (cellRange in grid.cpp) or from a precomputed table (the voxelizer's rows). The boundary formula is monotone
 // in c, so a guess from `scale` (n / extent) and a few steps against the true boundaries give the exact answer.
+// In core because the grid, the voxelizer and the packet tracer all need it.
 #pragma once
 
 #include <array>

@@ -5,8 +5,8 @@
 
 #include <gtest/gtest.h>
 
-#include "export/clip_triangle.h"
-#include "export/texture_average.h"
+#include "core/clip_triangle.h"
+#include "vox/core/texture_average.h"
 #include "vox/core/error.h"
 #include "vox/export/voxel_mesh.h"
 #include "vox/voxelize/voxelize.h"

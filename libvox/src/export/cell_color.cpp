@@ -5,7 +5,7 @@
 #include <utility>
 #include <vector>
 
-#include "export/texture_average.h"
+#include "vox/core/texture_average.h"
 #include "vox/core/error.h"
 #include "vox/export/voxel_mesh.h"
 

@@ -1,5 +1,6 @@
 // The average colour of an image texture over the part of a triangle inside a
-// cell, weighted by world-space area.
+// cell, weighted by world-space area. In core so that the exporters' cell
+// colours (export/cell_color.cpp) and the renderer can both reach it.
 #pragma once
 
 #include <array>

@@ -1,5 +1,5 @@
 // Triangle-box clipping (clip_triangle.h).
-#include "export/clip_triangle.h"
+#include "core/clip_triangle.h"
 
 #include <algorithm>
 

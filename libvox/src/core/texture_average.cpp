@@ -1,10 +1,10 @@
 // Area-weighted texture averages over a cell (texture_average.h).
-#include "export/texture_average.h"
+#include "vox/core/texture_average.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "export/clip_triangle.h"
+#include "core/clip_triangle.h"
 
 namespace vox {
 

@@ -5,7 +5,7 @@
 #include <new>
 
 #include "vox/core/error.h"
-#include "vox/io/input_file.h"
+#include "vox/core/quote_input.h"
 
 namespace vox {
 

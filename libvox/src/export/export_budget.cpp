@@ -2,7 +2,7 @@
 #include "export/export_budget.h"
 
 #include "vox/core/error.h"
-#include "vox/io/input_file.h"
+#include "vox/core/memory_budget.h"
 
 namespace vox {
 

@@ -18,7 +18,7 @@
 #include "vox/core/checked_math.h"
 #include "vox/core/error.h"
 #include "vox/export/voxel_runs.h"
-#include "vox/io/input_file.h"
+#include "vox/core/memory_budget.h"
 
 namespace vox {
 

@@ -4,9 +4,7 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 
@@ -14,25 +12,6 @@
 #include "vox/core/huge_pages.h"
 
 namespace vox {
-
-uint64_t memoryBudgetBytes() {
-  if (const char* env = std::getenv("VOX_MEMORY_LIMIT_MB")) {
-    char* end = nullptr;
-    const unsigned long long mb = std::strtoull(env, &end, 10);
-    if (end != env && *end == '\0' && mb > 0 && mb < (1ull << 40)) return mb << 20;
-  }
-  const long pages = ::sysconf(_SC_PHYS_PAGES), size = ::sysconf(_SC_PAGE_SIZE);
-  const uint64_t physical = pages > 0 && size > 0 ? uint64_t(pages) * uint64_t(size) : (16ull << 30);
-  return physical / 4 * 3;  // a quarter stays for the rest of the system
-}
-
-void checkMemory(double bytes, const std::string& where, const std::string& what) {
-  const uint64_t budget = memoryBudgetBytes();
-  if (!(bytes <= double(budget)))
-    fail<LimitError>(where, ": ", what, " needs about ",
-                     std::isfinite(bytes) ? uint64_t(bytes / (1 << 20)) : UINT64_MAX, " MiB, more than the ",
-                     budget >> 20, " MiB allowed");
-}
 
 void requireRegularFile(const std::string& path, const char* what) {
   struct stat st {};
@@ -94,26 +73,6 @@ std::string requireInsideFolder(const std::string& referrer, const std::string& 
     if (t == target.end() || *f != *t)
       fail<InputError>(referrer, ": '", quoteInput(path, 80), "': lies outside the folder of ", referrer);
   return target.string();
-}
-
-std::string quoteInput(const std::string& text, size_t maxBytes) {
-  std::string out;
-  for (size_t i = 0; i < text.size(); ++i) {
-    if (out.size() >= maxBytes) {
-      out += "...";
-      break;
-    }
-    const unsigned char c = static_cast<unsigned char>(text[i]);
-    // Bytes of 0x80 and above pass: they are UTF-8 in file names and text users wrote.
-    if (c >= 0x20 && c != 0x7f) {
-      out += char(c);
-    } else {
-      char hex[8];
-      std::snprintf(hex, sizeof hex, "\\x%02x", c);
-      out += hex;
-    }
-  }
-  return out;
 }
 
 }  // namespace vox

@@ -3,7 +3,7 @@
 #include <tbb/parallel_for.h>
 
 #include "vox/core/error.h"
-#include "vox/io/input_file.h"
+#include "vox/core/memory_budget.h"
 
 namespace vox {
 

@@ -5,15 +5,12 @@
 #include <cstdint>
 #include <string>
 
+// The budget these checks hold reads to, and the quoting their messages use, are core's (other stages use them too);
+// included here for the readers, which use all of them together.
+#include "vox/core/memory_budget.h"
+#include "vox/core/quote_input.h"
+
 namespace vox {
-
-// Bytes the tools may spend on one request: three quarters of physical memory, or VOX_MEMORY_LIMIT_MB when that
-// environment variable holds a positive number (tests use it to reach the limits quickly).
-uint64_t memoryBudgetBytes();
-
-// Throws LimitError "WHERE: WHAT needs N MiB, more than the M MiB allowed" when `bytes` exceeds memoryBudgetBytes().
-// Called before an allocation whose size the input decides.
-void checkMemory(double bytes, const std::string& where, const std::string& what);
 
 // Reads a whole regular file. Throws InputError naming `path` when it is missing, a folder, a FIFO or device
 // (which could block forever or never end), unreadable, or larger than the memory budget allows (LimitError).
@@ -30,9 +27,5 @@ std::string resolveInsideFolder(const std::string& referrer, const std::string& 
 // The canonical form of `path` (absolute, or relative to the current folder) when it lies inside the folder of
 // `referrer`; throws InputError naming the referrer otherwise.
 std::string requireInsideFolder(const std::string& referrer, const std::string& path);
-
-// `text` made safe to quote in a one-line message: control bytes (below 0x20, and 0x7f) escaped as \xHH, and cut
-// to about `maxBytes` with "..." when longer.
-std::string quoteInput(const std::string& text, size_t maxBytes = 40);
 
 }  // namespace vox

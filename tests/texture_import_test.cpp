@@ -12,7 +12,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "import/texture_decode.h"
+#include "vox/io/texture_decode.h"
 #include "test_util.h"
 #include "vox/core/error.h"
 #include "vox/export/cell_color.h"

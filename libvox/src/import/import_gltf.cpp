@@ -28,7 +28,7 @@
 #include <string_view>
 #include <vector>
 
-#include "import/texture_decode.h"
+#include "vox/io/texture_decode.h"
 #include "vox/core/error.h"
 #include "vox/import/import.h"
 #include "vox/io/input_file.h"

@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "import/obj_reader.h"
-#include "import/texture_decode.h"
+#include "vox/io/texture_decode.h"
 #include "vox/core/error.h"
 #include "vox/core/huge_pages.h"
 #include "vox/import/import.h"

@@ -1,5 +1,6 @@
 // Decoding of texture images held in memory (glTF images, OBJ map_Kd files), behind the OpenImageIO bridge
-// texture_decode.cpp.
+// texture_decode.cpp. In io beside the OpenImageIO module (io/oiio_module.h), the one place that opens it; the
+// importers call it.
 #pragma once
 
 #include <string>

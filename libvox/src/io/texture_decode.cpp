@@ -2,7 +2,7 @@
 // The PNG reader leaves libpng's default error handler in place, which prints "libpng error: ..." on stderr
 // before OIIO reports the failure: the library must not print, so PNG chunks (lengths, CRCs, IEND) are checked here
 // first, which refuses truncated and corrupted files before libpng sees them.
-#include "import/texture_decode.h"
+#include "vox/io/texture_decode.h"
 
 #include <algorithm>
 #include <array>

@@ -117,6 +117,7 @@ TEST(ImportCourse, Scene5_02HasFourSpheres) {
   }
   ASSERT_TRUE(s.camera);
   EXPECT_EQ(s.camera->kind, CameraKind::Orthographic);
+  EXPECT_EQ(s.camera->span, CameraSpan::LongerSide);  // the course's size spans the image's longer side
   EXPECT_EQ(s.lights.size(), 2u);
 }
 
@@ -128,6 +129,7 @@ TEST(ImportCourse, Scene5_04HasFiveSpheresAndAPlane) {
   EXPECT_EQ(s.planes[0].offset, -2);
   ASSERT_TRUE(s.camera);
   EXPECT_EQ(s.camera->kind, CameraKind::Perspective);
+  EXPECT_EQ(s.camera->span, CameraSpan::LongerSide);  // the course's angle spans the image's longer side
 }
 
 TEST(ImportCourse, Scene5_09Has40000TrianglesInTheReadmeBounds) {
@@ -608,6 +610,7 @@ TEST(ImportGltf, DuckHasACamera) {
   ASSERT_TRUE(s.camera);
   EXPECT_EQ(s.camera->kind, CameraKind::Perspective);
   EXPECT_NEAR(s.camera->fovDegrees, 0.6605925559997559 * 180 / M_PI, 1e-9);
+  EXPECT_EQ(s.camera->span, CameraSpan::Height);  // glTF's yfov is vertical
   // Camera node matrix translation (400.113, 463.264, -431.078) under the root's 0.01 scale.
   expectNear(s.camera->center, {4.00113, 4.63264, -4.31078}, 1e-5);
   EXPECT_EQ(loadScene(seed("gltf/Duck/glTF-Binary/Duck.glb")).triangles.size(), 4212u);
@@ -628,6 +631,7 @@ TEST(ImportGltf, CamerasTakesTheFirstCameraNode) {
   ASSERT_TRUE(s.camera);
   EXPECT_EQ(s.camera->kind, CameraKind::Perspective);
   EXPECT_NEAR(s.camera->fovDegrees, 0.7 * 180 / M_PI, 1e-12);
+  EXPECT_EQ(s.camera->span, CameraSpan::Height);
   expectNear(s.camera->center, {0.5, 0.5, 3}, 0);
   expectNear(s.camera->direction, {0, 0, -1}, 0);
   expectNear(s.camera->up, {0, 1, 0}, 0);

@@ -163,6 +163,54 @@ TEST(Camera, PrimaryRaysFollowTheConvention) {
   EXPECT_THROW(primaryRay(cam, 4, 2, 0.5, 0.5), UsageError);
 }
 
+// The course's cameras (CameraSpan::LongerSide) spread the angle or size over the longer side: across the width of a
+// wide image, with the height getting height / width of it; on square and tall images exactly as the vertical
+// convention (one pixel either side of square: 5x4, 4x4, 4x5).
+TEST(Camera, CourseCamerasSpanTheLongerSide) {
+  for (CameraKind kind : {CameraKind::Perspective, CameraKind::Orthographic}) {
+    Camera height;
+    height.kind = kind;
+    height.center = {1, 2, 3};
+    height.direction = {0, 0, -2};
+    height.up = {0, 3, 0};
+    height.fovDegrees = 90;  // tan(45) = 1
+    height.orthoHeight = 2;  // half extent 1
+    Camera course = height;
+    course.span = CameraSpan::LongerSide;
+    // The image plane point of a ray: its direction (perspective) or its origin's offset (orthographic).
+    auto plane = [&](const Camera& c, uint32_t w, uint32_t h, double px, double py) {
+      const Ray r = primaryRay(c, w, h, px, py);
+      return kind == CameraKind::Perspective ? r.direction : r.origin - c.center;
+    };
+    // 400x200: the right edge at u = 1 (45 degrees, or half the size), the top edge at v = 0.5.
+    EXPECT_NEAR(plane(course, 400, 200, 400, 100).x, 1, 1e-15) << int(kind);
+    EXPECT_NEAR(plane(course, 400, 200, 200, 0).y, 0.5, 1e-15);
+    EXPECT_NEAR(plane(height, 400, 200, 400, 100).x, 2, 1e-15);  // the vertical convention: twice as wide
+    EXPECT_NEAR(plane(height, 400, 200, 200, 0).y, 1, 1e-15);
+    // Pixel (i, j) of a W x H image looks through the course's screen point ((i + 0.5 - W/2) / max + 0.5, likewise
+    // j) of its square [0,1]^2 (its glCanvas.C), that is u = 2 x - 1, v = 1 - 2 y with rows counted from the top.
+    for (auto [w, h] : {std::pair<uint32_t, uint32_t>{5, 4}, {7, 3}, {400, 200}})
+      for (uint32_t j = 0; j < h; ++j)
+        for (uint32_t i = 0; i < w; ++i) {
+          const double m = std::max(w, h);
+          const double x = (i + 0.5 - w / 2.0) / m + 0.5, y = (j + 0.5 - h / 2.0) / m + 0.5;
+          const Vec3 p = plane(course, w, h, i + 0.5, j + 0.5);
+          EXPECT_NEAR(p.x, 2 * x - 1, 1e-14) << w << "x" << h << " " << i << " " << j;
+          EXPECT_NEAR(p.y, 1 - 2 * y, 1e-14) << w << "x" << h << " " << i << " " << j;
+        }
+    // Square and tall images: the same rays as the vertical convention, bit for bit.
+    for (auto [w, h] : {std::pair<uint32_t, uint32_t>{4, 4}, {4, 5}, {1, 1}, {200, 400}})
+      for (double py : {0.0, 0.5, h / 3.0, h - 0.5, double(h)})
+        for (double px : {0.0, 0.5, w / 3.0, w - 0.5, double(w)}) {
+          const Ray a = primaryRay(course, w, h, px, py), b = primaryRay(height, w, h, px, py);
+          for (int c = 0; c < 3; ++c) {
+            EXPECT_EQ(a.origin[c], b.origin[c]) << w << "x" << h << " " << px << " " << py;
+            EXPECT_EQ(a.direction[c], b.direction[c]) << w << "x" << h << " " << px << " " << py;
+          }
+        }
+  }
+}
+
 Scene planeScene() {
   Scene scene;
   scene.materials.push_back({});

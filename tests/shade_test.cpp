@@ -3,8 +3,11 @@
 // random reflective and refractive scenes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <fstream>
+#include <iterator>
 #include <random>
 
 #include "test_util.h"
@@ -277,7 +280,7 @@ struct CourseLine {
   uint32_t bounces;
   bool shadeBack, shadows;
   uint32_t samples;  // -jittered_samples, with -gaussian_filter 0.4 when > 1
-  bool wide;         // 400x200 lines
+  bool wide;         // 400x200 lines (the course's camera spans their width)
 };
 const CourseLine kCourseLines[] = {
     {"scene6_11_mirrored_floor.txt", {40, 10, 40}, 1, false, true, 1, false},
@@ -331,6 +334,98 @@ INSTANTIATE_TEST_SUITE_P(Assignments6And7, CourseBounces, ::testing::ValuesIn(kC
                              if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
                            return name;
                          });
+
+// ---- framing of the course's non-square line ----
+
+// A 24-bit TGA as the course's code writes it (seed-scenes/6837/README.md "TGA format": 18-byte header, type 2,
+// 24 bits, top-left origin), as RGB bytes, rows from the top.
+struct Rgb8 {
+  uint32_t width = 0, height = 0;
+  std::vector<uint8_t> rgb;
+};
+Rgb8 readCourseTga(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  Rgb8 out;
+  if (bytes.size() < 18) return out;
+  const auto byte = [&](size_t i) { return uint8_t(bytes[i]); };
+  EXPECT_EQ(byte(2), 2);
+  EXPECT_EQ(byte(16), 24);
+  EXPECT_EQ(byte(17), 0x20);
+  out.width = byte(12) | byte(13) << 8;
+  out.height = byte(14) | byte(15) << 8;
+  const size_t start = 18 + byte(0), n = size_t(out.width) * out.height;
+  if (bytes.size() < start + 3 * n) return Rgb8{};
+  for (size_t p = 0; p < n; ++p)
+    for (int c = 2; c >= 0; --c) out.rgb.push_back(byte(start + 3 * p + c));  // B, G, R
+  return out;
+}
+
+// Mean absolute difference per channel, 0..255, between `img` written to 8 bits (clamped and rounded, as
+// writeImage does) and `ref` averaged over blocks of `scale` x `scale` pixels down to img's size.
+double meanDifference(const Image& img, const Rgb8& ref, uint32_t scale) {
+  EXPECT_EQ(img.width * scale, ref.width);
+  EXPECT_EQ(img.height * scale, ref.height);
+  if (img.width * scale != ref.width || img.height * scale != ref.height) return 255;
+  double sum = 0;
+  for (uint32_t y = 0; y < img.height; ++y)
+    for (uint32_t x = 0; x < img.width; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const double ours = std::lround(std::clamp(double(img.at(x, y)[c]), 0.0, 1.0) * 255);
+        double theirs = 0;
+        for (uint32_t j = 0; j < scale; ++j)
+          for (uint32_t i = 0; i < scale; ++i)
+            theirs += ref.rgb[3 * ((size_t(y) * scale + j) * ref.width + size_t(x) * scale + i) + c];
+        sum += std::fabs(ours - theirs / (scale * scale));
+      }
+  return sum / (3.0 * img.width * img.height);
+}
+
+// scene6_18's handout line renders 400x200 (-shadows -shade_back -bounces 5 -weight 0.01 -grid 80 30 3): the
+// course's PerspectiveCamera spans its 40 degrees over the image's width, so our image frames like one student's
+// render of that line (seed-scenes/6837/unofficial-renders). Mean difference 21.30 with the scene's camera; 21.33
+// with what `--fov 20.63` (= 2 atan(tan(20) / 2), the compensation the README used) makes of it; 41.59 with the
+// angle spread over the height, as before.
+TEST(CourseCamera, WideLogoLineFramesLikeTheCourse) {
+  const std::string dir = std::string(VOX_SEED_DIR) + "/6837/";
+  const Scene scene = loadScene(dir + "scenes/scene6_18_6.837_logo.txt");
+  const Rgb8 student = readCourseTga(dir + "unofficial-renders/tsssni-mit-6.837/assignment6/output6_18a.tga");
+  ASSERT_EQ(student.width, 400u);
+  ASSERT_EQ(student.height, 200u);
+  ASSERT_TRUE(scene.camera);
+  ASSERT_EQ(scene.camera->span, CameraSpan::LongerSide);
+  const Grid grid = voxelize(scene, {80, 30, 3});
+  const Accel accel = buildAccel(scene, grid, AccelKind::Grid);
+  const uint32_t scale = kSanitized ? 4 : 1;  // the sanitizers' run compares a quarter-size image
+  RenderOptions ro;
+  ro.width = 400 / scale, ro.height = 200 / scale;
+  ro.bounces = 5;
+  ro.weight = 0.01;
+  ro.shadeBack = true;
+  const auto difference = [&](const Camera& camera) {
+    ro.camera = camera;
+    return meanDifference(traceImage(scene, accel, ro), student, scale);
+  };
+  const double course = difference(*scene.camera);
+  Camera fov = *scene.camera;  // what `--fov 20.63` made of it (tools/trace/main.cpp resolveCamera)
+  fov.fovDegrees = 20.63;
+  fov.span = CameraSpan::Height;
+  const double compensated = difference(fov);
+  Camera vertical = *scene.camera;  // the scene's angle spread over the height, as before
+  vertical.span = CameraSpan::Height;
+  const double before = difference(vertical);
+  if (kSanitized) {
+    EXPECT_NEAR(course, compensated, 0.1);  // 100x50: 17.50 and 17.47, the two framings agree to 0.002 degrees
+  } else {
+    EXPECT_LE(course, compensated);  // 21.30 and 21.33
+    EXPECT_LT(course, 21.5);
+    EXPECT_GT(before, 40.0);  // 41.59
+  }
+  EXPECT_LT(course, 0.6 * before);
+  RecordProperty("mean_difference_course", std::to_string(course));
+  RecordProperty("mean_difference_fov_20_63", std::to_string(compensated));
+  RecordProperty("mean_difference_vertical", std::to_string(before));
+}
 
 }  // namespace
 }  // namespace vox

@@ -43,6 +43,8 @@ vox::Camera resolveCamera(const PyGrid& g, const py::object& eye, const py::obje
     cam.direction = l - e;
     cam.up = scene.up;
     cam.fovDegrees = scene.kind == CameraKind::Perspective ? scene.fovDegrees : 45;
+    // The scene's angle keeps the side it spans, so that moving the eye keeps the framing's width.
+    if (scene.kind == CameraKind::Perspective) cam.span = scene.span;
     if (!(length(cam.direction) > 0)) fail<UsageError>("eye and look_at must differ");
   }
   if (!up.is_none()) cam.up = vec3Arg(up, "up");
@@ -51,6 +53,7 @@ vox::Camera resolveCamera(const PyGrid& g, const py::object& eye, const py::obje
     if (!(f > 0 && f < 180)) fail<UsageError>("fov must be between 0 and 180 degrees, got ", f);
     cam.kind = CameraKind::Perspective;
     cam.fovDegrees = f;
+    cam.span = CameraSpan::Height;  // fov is vertical, whatever the scene's camera spans
   }
   validateCamera(cam, "camera");
   return cam;

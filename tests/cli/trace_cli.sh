@@ -85,6 +85,36 @@ PY
 expect 0 "voxels, samples, camera overrides, threads" -- "$TRACE" "$WORK/b.vgrid" -o "$WORK/v.tga" --size 30 20 \
   --mode voxels --samples 4 --eye 0 0.3 1 --look-at 0 0.2 0 --up 0 1 0 --fov 40 --threads 1 -q
 
+# Camera conventions (DESIGN.md "vox-trace"): the course's angle spans the longer side of the image, --fov and glTF's
+# yfov the height. scene6_02's camera has angle 30: on a square image --fov 30 gives the same file, on a wide one
+# --fov 30 frames less (the flag stays vertical and overrides); --eye/--look-at keep the scene's angle and its side.
+frame() {  # NAME SIZE... -- extra options
+  local name=$1 w=$2 h=$3
+  shift 3
+  "$TRACE" "$WORK/s.vgrid" -o "$WORK/cam_$name.png" --size "$w" "$h" --mode normals -q "$@" || fail "camera $name"
+}
+frame sq 24 24
+frame sq_fov 24 24 --fov 30
+cmp -s "$WORK/cam_sq.png" "$WORK/cam_sq_fov.png" || fail "course camera on a square image: --fov 30 changed it"
+frame wide 48 24
+frame wide_fov 48 24 --fov 30
+cmp -s "$WORK/cam_wide.png" "$WORK/cam_wide_fov.png" && fail "course camera on a wide image: --fov 30 did not override"
+frame eye 48 24 --eye 0 2 10 --look-at 0 1 5
+frame eye_fov 48 24 --eye 0 2 10 --look-at 0 1 5 --fov 30
+cmp -s "$WORK/cam_eye.png" "$WORK/cam_eye_fov.png" && fail "--eye: the course's angle did not keep its side"
+frame eye_sq 24 24 --eye 0 2 10 --look-at 0 1 5
+frame eye_sq_fov 24 24 --eye 0 2 10 --look-at 0 1 5 --fov 30
+cmp -s "$WORK/cam_eye_sq.png" "$WORK/cam_eye_sq_fov.png" || fail "--eye on a square image: --fov 30 changed it"
+# A glTF camera (yfov 0.7 radians) is vertical: a wide image with it and with --fov of the same angle is one file.
+GLTF="${VOX_SEED_DIR:-$SRC/../shared/seed-scenes}/gltf/Cameras/glTF/Cameras.gltf"
+"$VOXELIZE" "$GLTF" -o "$WORK/gltf.vgrid" --grid 4 4 1 -q || fail "voxelize glTF camera scene"
+yfov=$(python3 -c 'import math; print(repr(0.7 * 180 / math.pi))')
+for fov in "" "--fov $yfov"; do
+  # shellcheck disable=SC2086
+  "$TRACE" "$WORK/gltf.vgrid" -o "$WORK/gltf${fov:+_fov}.png" --size 48 24 --mode normals -q $fov || fail "glTF $fov"
+done
+cmp -s "$WORK/gltf.png" "$WORK/gltf_fov.png" || fail "glTF camera on a wide image: not the vertical --fov $yfov"
+
 # Bad grid files: truncated, corrupt, missing, not a grid at all.
 size=$(stat -c %s "$WORK/s.vgrid")
 head -c $((size / 2)) "$WORK/s.vgrid" >"$WORK/truncated.vgrid"

@@ -56,6 +56,8 @@ vox::Camera resolveCamera(const Options& opt, const vox::GridFile& file) {
     cam.direction = vec(opt.lookAt) - vec(opt.eye);
     cam.up = scene.up;
     cam.fovDegrees = scene.kind == CameraKind::Perspective ? scene.fovDegrees : 45;
+    // The scene's angle keeps the side it spans, so that moving the eye keeps the framing's width.
+    if (scene.kind == CameraKind::Perspective) cam.span = scene.span;
     if (!isFinite(cam.center) || !isFinite(vec(opt.lookAt))) fail<UsageError>("--eye and --look-at must be finite");
     if (!(length(cam.direction) > 0)) fail<UsageError>("--eye and --look-at must differ");
   }
@@ -63,6 +65,7 @@ vox::Camera resolveCamera(const Options& opt, const vox::GridFile& file) {
   if (opt.fov != 0) {
     cam.kind = CameraKind::Perspective;
     cam.fovDegrees = opt.fov;
+    cam.span = CameraSpan::Height;  // --fov is vertical (DESIGN.md), whatever the scene's camera spans
   }
   return cam;
 }

@@ -217,6 +217,10 @@ class CourseParser {
     expect("{");
     Camera cam;
     cam.kind = orthographic ? CameraKind::Orthographic : CameraKind::Perspective;
+    // The course's generateRay takes a point of [0,1]^2 that spans the angle or size, and its glCanvas.C maps pixel
+    // (i, j) of a W x H image to ((i + 0.5 - W/2) / max(W, H) + 0.5, likewise j): the square covers the longer side
+    // and the shorter one sees the middle of it (its OrthographicCamera::glInit spreads `size` the same way).
+    cam.span = CameraSpan::LongerSide;
     // The course's parser wants these fields in exactly this order.
     cam.center = readField("center");
     cam.direction = readDirection("direction");

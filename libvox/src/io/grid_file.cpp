@@ -94,6 +94,7 @@ const std::vector<SectionCodec>& sectionCodecs() {
       {SectionTag::Textures, "textures", hasTexturesSection, putTexturesSection, getTexturesSection},
       {SectionTag::SolidTextures, "solid textures", hasSolidTexturesSection, putSolidTexturesSection,
        getSolidTexturesSection},
+      {SectionTag::CameraSpan, "camera span", hasCameraSpanSection, putCameraSpanSection, getCameraSpanSection},
   };
   return codecs;
 }

@@ -15,7 +15,7 @@
 
 namespace vox {
 
-enum class SectionTag : uint32_t { Textures = 1, SolidTextures = 2, Brick = 3 };
+enum class SectionTag : uint32_t { Textures = 1, SolidTextures = 2, Brick = 3, CameraSpan = 4 };
 
 struct SectionCodec {
   SectionTag tag;
@@ -34,5 +34,10 @@ void getTexturesSection(ByteReader& r, Scene& scene, Grid& grid);
 bool hasSolidTexturesSection(const Scene& scene, const Grid& grid);
 void putSolidTexturesSection(ByteWriter& w, const Scene& scene, const Grid& grid);
 void getSolidTexturesSection(ByteReader& r, Scene& scene, Grid& grid);
+
+// CameraSpan (io/grid_section_camera.cpp): the side of the image a camera's angle or size spans, when not the height.
+bool hasCameraSpanSection(const Scene& scene, const Grid& grid);
+void putCameraSpanSection(ByteWriter& w, const Scene& scene, const Grid& grid);
+void getCameraSpanSection(ByteReader& r, Scene& scene, Grid& grid);
 
 }  // namespace vox

@@ -33,7 +33,7 @@ Vec3 voxelColor(uint32_t count, uint32_t maxCount) { return countColor(count, ma
 
 struct Frame {
   Vec3 dir, right, up;
-  double halfHeight = 1;  // of the image plane at distance 1 (perspective) or in world units (orthographic)
+  double halfHeight = 1;  // half the span of the image plane at distance 1 (perspective) or in world units (ortho)
 };
 
 Frame cameraFrame(const Camera& c) {
@@ -48,16 +48,21 @@ Frame cameraFrame(const Camera& c) {
 }
 
 Ray rayFromFrame(const Camera& camera, const Frame& f, uint32_t width, uint32_t height, double px, double py) {
-  const double aspect = double(width) / double(height);
+  // The camera's angle or size spans the height, or for the course's cameras the longer side: across a wide image
+  // it spans the width and the height gets height / width of it. Factors of exactly 1 keep the products of square
+  // images and of CameraSpan::Height bit for bit what they were.
+  const bool acrossWidth = camera.span == CameraSpan::LongerSide && width > height;
+  const double across = acrossWidth ? 1.0 : double(width) / double(height);
+  const double upward = acrossWidth ? double(height) / double(width) : 1.0;
   const double sx = 2 * px / width - 1;
   const double sy = 1 - 2 * py / height;
   Ray ray;
   const double h = f.halfHeight;
   if (camera.kind == CameraKind::Perspective) {
     ray.origin = camera.center;
-    ray.direction = f.dir + f.right * (sx * h * aspect) + f.up * (sy * h);
+    ray.direction = f.dir + f.right * (sx * h * across) + f.up * (sy * h * upward);
   } else {
-    ray.origin = camera.center + f.right * (sx * h * aspect) + f.up * (sy * h);
+    ray.origin = camera.center + f.right * (sx * h * across) + f.up * (sy * h * upward);
     ray.direction = f.dir;
   }
   return ray;

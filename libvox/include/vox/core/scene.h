@@ -55,14 +55,21 @@ struct Plane {
 
 enum class CameraKind : uint8_t { Perspective = 0, Orthographic = 1 };
 
+// Which side of the image a camera's angle (perspective) or size (orthographic) spans.
+enum class CameraSpan : uint8_t {
+  Height = 0,      // DESIGN.md's convention: vox-trace's flags, glTF cameras, defaultCamera
+  LongerSide = 1,  // the course's cameras: the width of a wide image, the height of a square or tall one
+};
+
 // `direction` and `up` need not be unit length or orthogonal; renderers orthonormalise them as DESIGN.md says.
 struct Camera {
   CameraKind kind = CameraKind::Perspective;
   Vec3 center{0, 0, 5};
   Vec3 direction{0, 0, -1};
   Vec3 up{0, 1, 0};
-  double fovDegrees = 45;  // perspective: vertical field of view
-  double orthoHeight = 2;  // orthographic: world-space height of the image plane (the course's `size`)
+  double fovDegrees = 45;  // perspective: field of view across the side `span` names (vertical by default)
+  double orthoHeight = 2;  // orthographic: world extent of the image plane across that side (the course's `size`)
+  CameraSpan span = CameraSpan::Height;
 };
 
 enum class LightKind : uint8_t { Directional = 0, Point = 1 };

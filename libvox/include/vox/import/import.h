@@ -13,7 +13,8 @@ Scene loadScene(const std::string& path);
 
 // The MIT 6.837 text scene format (grammar in seed-scenes/6837/README.md). TriangleMesh paths are resolved relative
 // to the scene file's folder. Procedural materials (Checkerboard, Noise, Marble, Wood) become their first
-// material's colour, with a warning.
+// material's colour, with a warning. Cameras get CameraSpan::LongerSide: the angle or size spans the image's longer
+// side, as in the course's code.
 Scene importCourseScene(const std::string& path);
 // Wavefront OBJ, read by libvox's own reader in double precision (a coordinate comes back bit for bit from 17
 // significant digits): polygons of any size fan-triangulated, negative indices, line continuations. .mtl: Kd ->

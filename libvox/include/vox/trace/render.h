@@ -57,7 +57,8 @@ struct RenderStats {
 // The primary ray through image position (px, py), in pixels from the top-left corner (pixel centres at +0.5),
 // by the camera convention of DESIGN.md: right = normalize(direction x up), trueUp = right x direction,
 // perspective rays from the centre through direction + u right + v trueUp (u, v from the vertical fov, v up),
-// orthographic rays parallel to direction from centre + u right + v trueUp (u, v from orthoHeight).
+// orthographic rays parallel to direction from centre + u right + v trueUp (u, v from orthoHeight). A camera with
+// CameraSpan::LongerSide (the course's) spreads its fov or orthoHeight over the width instead when width > height.
 // The direction of a perspective ray is not normalised. Throws UsageError for a degenerate camera.
 Ray primaryRay(const Camera& camera, uint32_t width, uint32_t height, double px, double py);
 

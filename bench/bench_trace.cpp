@@ -509,6 +509,8 @@ void benchIncoherent(const std::string& path, unsigned threads, uint32_t size, i
   // copies (what a grid over the copies' budget does).
   vox::Accel byId = vox::buildAccel(scene, grid, vox::AccelKind::Grid);
   byId.floatCells = {};
+  // The uniform walk (no cell boxes: every cell crossed is visited), the walk before issue 27.
+  const vox::Accel uniform = vox::buildAccel(scene, grid, vox::AccelKind::Uniform);
   const std::vector<RaySet> sets = secondaryRays(accel, tileRays(primary, size).rays, bounds);
   const EmbreeScene embree(scene, threads);
   const double diag = vox::length(bounds.hi - bounds.lo);
@@ -544,7 +546,14 @@ void benchIncoherent(const std::string& path, unsigned threads, uint32_t size, i
     for (size_t i = 0; i < set.rays.size(); ++i) stopT[i] = vox::traceRay(accel, set.rays[i]).t;
     std::atomic<uint64_t> sink{0};
     methods.push_back({"textbook walk alone", [&] { textbookWalk(accel, set, stopT, sink); }});
+    std::vector<vox::Hit> uniformHits(set.rays.size());
+    methods.push_back({"ours uniform", [&] { voxTrace(uniform, set, uniformHits); }});
     timeInTurns(methods, reps);
+    const uint64_t uniformDiff = differingHits(ours, uniformHits);
+    vox::TraceStats uniformStats;
+    for (size_t i = 0; i < set.rays.size(); i += 97)
+      set.occlusion ? void(vox::occluded(uniform, set.rays[i], &uniformStats))
+                    : void(vox::traceRay(uniform, set.rays[i], &uniformStats));
     const uint64_t packetDiff = differingHits(ours, packetHits), byIdDiff = differingHits(ours, byIdHits);
     const uint64_t textbookDiff = differingHits(ours, textbookHits);
     const Agreement a = compareWithEmbree(set, ours, e, diag);
@@ -559,7 +568,7 @@ void benchIncoherent(const std::string& path, unsigned threads, uint32_t size, i
         "  %-11s %10s %8.2f M %10.2f M %12.3f %8.3f %8.3f %8.3f%% %8.3f%% %9llu %llu/%llu  %.1f cells, %.1f tests "
         "(%.2f in double)"
         "  double only: %.3f (cpu %.3f), %llu differ  packets/embree: %.3f, %llu differ"
-        "  textbook/embree: %.3f (walk alone %.3f), %llu differ\n",
+        "  textbook/embree: %.3f (walk alone %.3f), %llu differ  uniform/embree: %.3f (%.1f cells), %llu differ\n",
         set.name.c_str(), set.occlusion ? "occluded" : "closest", n / methods[0].median() / 1e6,
         n / methods[1].median() / 1e6, methods[0].median() / methods[1].median(), methods[0].best / methods[1].best,
         methods[0].median(true) / methods[1].median(true), 100.0 * a.same / n, 100.0 * a.closeT / n,
@@ -568,7 +577,8 @@ void benchIncoherent(const std::string& path, unsigned threads, uint32_t size, i
         methods[2].median() / methods[1].median(), methods[2].median(true) / methods[1].median(true),
         (unsigned long long)byIdDiff, methods[0].median() / methods[3].median(), (unsigned long long)packetDiff,
         methods[0].median() / methods[4].median(), methods[0].median() / methods[5].median(),
-        (unsigned long long)textbookDiff);
+        (unsigned long long)textbookDiff, methods[0].median() / methods[6].median(),
+        double(uniformStats.cells) / uniformStats.rays, (unsigned long long)uniformDiff);
     std::fflush(stdout);
   }
 }

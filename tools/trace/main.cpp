@@ -148,7 +148,9 @@ int main(int argc, char** argv) {
                  "shade (materials, lights, shadows), voxels (occupied cells as cubes coloured by primitive count), "
                  "count (heat map of cells visited per pixel), normals ((n+1)/2 of the normal facing the viewer), "
                  "depth (distance along the unit ray; float in EXR/TIFF, grey near-bright otherwise)");
-  app.add_option("--accel", opt.accel, "grid (walk the grid) or none (test every primitive)");
+  app.add_option("--accel", opt.accel,
+                 "grid (walk the grid, jumping over empty boxes), uniform (step through every cell) or none (test "
+                 "every primitive)");
   app.add_option("--samples", opt.samples, "Jittered samples per pixel (stratified when a square number)");
   app.add_option("--bounces", opt.bounces, "Shade mode: reflection and refraction depth (default 0, the course's)");
   app.add_option("--weight", opt.weight, "Shade mode: stop a path whose contribution falls under W (default 0.01)");

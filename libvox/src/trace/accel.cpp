@@ -12,7 +12,8 @@ namespace vox {
 AccelKind parseAccel(const std::string& name) {
   if (name == "grid") return AccelKind::Grid;
   if (name == "none") return AccelKind::None;
-  fail<UsageError>("unknown acceleration '", name, "' (expected grid or none)");
+  if (name == "uniform") return AccelKind::Uniform;
+  fail<UsageError>("unknown acceleration '", name, "' (expected grid, uniform or none)");
 }
 
 uint32_t Accel::lookupSlow(uint32_t i, uint32_t j, uint32_t k) const {
@@ -143,7 +144,9 @@ void buildEmptyShift(Accel& accel) {
     if (level[0][b]) accel.emptyShift[b] = uint8_t(accel.blockShift + level[0][b] - 1);
 }
 
-Accel buildAccel(const Scene& scene, const Grid& grid, AccelKind kind) {
+Accel buildAccel(const Scene& scene, const Grid& grid, AccelKind requested) {
+  // The uniform walk is the grid walk without cell boxes.
+  const AccelKind kind = requested == AccelKind::Uniform ? AccelKind::Grid : requested;
   Accel accel;
   accel.kind = kind;
   accel.grid = &grid;
@@ -181,6 +184,7 @@ Accel buildAccel(const Scene& scene, const Grid& grid, AccelKind kind) {
       if (grid.primIds[r] < accel.triangleCount) accel.cellTriangles[r] = accel.triangles[grid.primIds[r]];
   }
   if (kind == AccelKind::Grid) filter::buildFloatCells(accel, grid, kMaxCellTriangleBytes);
+  if (requested == AccelKind::Grid) buildCellBoxes(accel);
   return accel;
 }
 

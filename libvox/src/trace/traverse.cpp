@@ -167,6 +167,15 @@ void GridWalker::queueExtras(int m, double tm, const WalkCell& from, bool n1, bo
 // are block faces, so the steps after the jump still look at each new block as they enter it.
 void GridWalker::fastForward(uint32_t shift) {
   const int64_t mask = (int64_t(1) << shift) - 1;
+  int64_t lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = idx_[a] & ~mask;
+    hi[a] = std::min<int64_t>(idx_[a] | mask, int64_t(dims_[a]) - 1);
+  }
+  fastForwardBox(lo, hi);
+}
+
+void GridWalker::fastForwardBox(const int64_t lo[3], const int64_t hi[3]) {
   double tB[3];
   int64_t far[3];
   for (int a = 0; a < 3; ++a) {
@@ -175,7 +184,7 @@ void GridWalker::fastForward(uint32_t shift) {
       far[a] = -1;
       continue;
     }
-    far[a] = step_[a] > 0 ? std::min<int64_t>((idx_[a] | mask) + 1, int64_t(dims_[a])) : (idx_[a] & ~mask);
+    far[a] = step_[a] > 0 ? hi[a] + 1 : lo[a];
     const double b = bnd_[a][far[a]];
     tB[a] = ax_.crossing(a, b, org_[a], dir_[a]);
   }
@@ -329,15 +338,28 @@ inline bool walkCells(const Accel& accel, const Ray& ray, Hit& best, TraceStats&
   GridWalker walker(accel, ray, EmptySkip::Boxes);
   Mailbox<64> mailbox;
   bool anyHit = false;
+  const bool boxes = !accel.cellBoxes.empty();
+  // Which side of a cell box lies ahead on each axis (a box reaching only backwards or sideways saves no step).
+  const bool ahead[3] = {ray.direction.x > 0, ray.direction.y > 0, ray.direction.z > 0};
+  const bool behind[3] = {ray.direction.x < 0, ray.direction.y < 0, ray.direction.z < 0};
   walker.walk([&](const WalkCell& cell) {
     ++st.cells;
     bool hit = false;
-    if (direct) {
-      hit = testGroups<AnyHit>(accel, accel.floatCell(cell.idx[0], cell.idx[1], cell.idx[2]), ray, *fr, mailbox, best,
-                               st);
-    } else {
-      const uint32_t c = accel.lookup(cell.idx[0], cell.idx[1], cell.idx[2]);
+    const uint32_t i = cell.idx[0], j = cell.idx[1], k = cell.idx[2];
+    if (accel.blockShift == 0) {
+      const uint32_t c = accel.lookupSlow(i, j, k);
       if (c < kSolidCell) hit = testCell<AnyHit>(accel, c, ray, fr, mailbox, best, st);
+    } else if (const uint64_t slot = accel.slotOf(i, j, k); slot != UINT64_MAX) {
+      const uint32_t c = accel.cellSlots[slot];
+      if (c < kSolidCell) {
+        hit = direct ? testGroups<AnyHit>(accel, accel.floatCells.slots[slot], ray, *fr, mailbox, best, st)
+                     : testCell<AnyHit>(accel, c, ray, fr, mailbox, best, st);
+      } else if (boxes && !cell.extra) {
+        const CellBox& b = accel.cellBoxes[slot];
+        if ((ahead[0] & (b.hi[0] != 0)) | (ahead[1] & (b.hi[1] != 0)) | (ahead[2] & (b.hi[2] != 0)) |
+            (behind[0] & (b.lo[0] != 0)) | (behind[1] & (b.lo[1] != 0)) | (behind[2] & (b.lo[2] != 0)))
+          walker.jumpOver({i - b.lo[0], j - b.lo[1], k - b.lo[2]}, {i + b.hi[0], j + b.hi[1], k + b.hi[2]});
+      }
     }
     if (AnyHit) {
       anyHit = hit;

@@ -14,9 +14,12 @@
 
 namespace vox {
 
-// `Grid` walks the cells; `None` tests every primitive for every ray (brute force, the reference for tests).
-enum class AccelKind : uint8_t { Grid, None };
-// Throws UsageError for a name other than "grid" or "none".
+// `Grid` walks the cells, jumping over the box of empty cells around each empty cell it enters (Accel::cellBoxes,
+// issue 27); `Uniform` walks every cell the ray crosses, as the uniform 3D-DDA does (built as a Grid accel without
+// cell boxes: buildAccel returns kind Grid); `None` tests every primitive for every ray (brute force, the reference
+// for tests).
+enum class AccelKind : uint8_t { Grid, None, Uniform };
+// Throws UsageError for a name other than "grid", "uniform" or "none".
 AccelKind parseAccel(const std::string& name);
 
 // The cell boundaries of a grid as tables: b[a][i] == cellBoundary(bounds, dims, a, i) for i in [0, dims[a]], the
@@ -60,6 +63,11 @@ struct FloatCells {
 };
 
 inline constexpr uint32_t kEmptyCell = 0xffffffffu;
+// Accel::cellBoxes: cells the box reaches below (lo) and above (hi) its cell on each axis, at most kMaxBoxReach.
+struct CellBox {
+  uint8_t lo[3], hi[3];
+};
+inline constexpr uint32_t kMaxBoxReach = 255;
 inline constexpr uint32_t kSolidCell = 0xfffffffeu;
 
 struct Accel {
@@ -94,6 +102,11 @@ struct Accel {
   std::vector<TriangleData> cellTriangles;
   // The float copies of the cells' triangles for the single-ray walk (AccelKind::Grid; empty over the budget).
   FloatCells floatCells;
+  // Per cell slot (laid out as cellSlots), for an empty or solid cell: the box of cells around it that holds no
+  // primitive, as the number of cells it reaches below and above the cell on each axis (0 for an occupied cell).
+  // A walk that enters such a cell has nothing to test until it leaves the box, and jumps to its exit (issue 27;
+  // trace/cell_boxes.cpp). Empty for AccelKind::Uniform, without block tables, or for grids over kMaxBoxGridCells.
+  std::vector<CellBox> cellBoxes;
 
   uint32_t primitiveCount() const { return triangleCount + sphereCount + planeCount; }
 
@@ -118,6 +131,15 @@ struct Accel {
     const uint32_t m = (1u << s) - 1;
     return floatCells.slots[(uint64_t(b) << (3 * s)) + ((i & m) | ((j & m) << s) | ((k & m) << (2 * s)))];
   }
+  // The slot of cell (i,j,k) in cellSlots (and cellBoxes, floatCells.slots), or UINT64_MAX in an empty block; only
+  // with block tables.
+  uint64_t slotOf(uint32_t i, uint32_t j, uint32_t k) const {
+    const uint32_t s = blockShift;
+    const uint32_t b = blockSlot[(i >> s) + blockDims[0] * ((j >> s) + uint64_t(blockDims[1]) * (k >> s))];
+    if (b == kEmptyCell) return UINT64_MAX;
+    const uint32_t m = (1u << s) - 1;
+    return (uint64_t(b) << (3 * s)) + ((i & m) | ((j & m) << s) | ((k & m) << (2 * s)));
+  }
   // True when the whole block holding cell (i,j,k) is empty (always false without tables).
   bool blockEmpty(uint32_t i, uint32_t j, uint32_t k) const {
     if (blockShift == 0) return false;
@@ -129,6 +151,11 @@ struct Accel {
 
 // Fills accel.emptyShift from accel.blockSlot (nothing without block tables).
 void buildEmptyShift(Accel& accel);
+// Fills accel.cellBoxes from the block tables (nothing without them, or for grids over kMaxBoxGridCells cells): for
+// each empty or solid cell, a box of cells holding no primitive, grown greedily one layer at a time, each of the six
+// faces in turn, while the layer holds no occupied cell and the reach stays within kMaxBoxReach.
+inline constexpr uint64_t kMaxBoxGridCells = uint64_t(1) << 25;
+void buildCellBoxes(Accel& accel);
 
 inline constexpr uint64_t kMaxCellTriangleBytes = uint64_t(512) << 20;
 

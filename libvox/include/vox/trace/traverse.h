@@ -148,6 +148,20 @@ class GridWalker {
   template <class Visit>
   void walk(Visit&& visit);
 
+  // Called by walk()'s visitor on the cell it is visiting (not on an extra one): every cell of the box [lo, hi]
+  // (inclusive indices, holding that cell) is known to hold nothing the ray must test, so the walk may jump to the
+  // last cell of the box along the ray instead of stepping through it (Accel::cellBoxes, issue 27). The jump is
+  // taken only where it is as robust as a step: not when the ray leaves the box near one of its edges or corners
+  // (see fastForwardBox). Ignored for extra cells and by the next() path.
+  void jumpOver(const std::array<uint32_t, 3>& lo, const std::array<uint32_t, 3>& hi) {
+    for (int a = 0; a < 3; ++a) {
+      jumpLo_[a] = lo[a];
+      jumpHi_[a] = hi[a];
+    }
+    jump_ = true;
+  }
+  uint64_t jumpsTaken() const { return jumps_; }
+
   // Bound on the error of a primitive hit's t at parameter t (ray units), used to decide when the walk may stop.
   double hitSlack(double t) const { return ax_.hitSlackAt(t); }
   uint64_t stepsTaken() const { return steps_; }
@@ -231,6 +245,12 @@ class GridWalker {
     return skip > minSkip_ ? skip : 0;
   }
   void fastForward(uint32_t shift);
+  // Moves the walk to the cell holding the ray just before it leaves the box [lo, hi] (inclusive cell indices,
+  // holding the current cell), as the steps would, but for the cells in between; nothing when the ray leaves the
+  // box within tolerance of two of its faces at once or never leaves it.
+  void fastForwardBox(const int64_t lo[3], const int64_t hi[3]);
+  // walk()'s side of jumpOver: the jump from the state `w`; false (w unchanged) when it would not move the walk.
+  bool takeJump(WalkState& w);
   // Boxes whose far face lies more cells away on an axis than this are crossed by advanceBySearch, not cell by cell.
   static constexpr int64_t kMaxLoopCells = 32;
   void advanceBySearch(int a, int64_t far, double T);
@@ -256,6 +276,10 @@ class GridWalker {
   const uint8_t* emptyShift_ = nullptr;  // Accel::emptyShift, when built
   bool checkBlock_ = false;
   uint32_t minSkip_ = 0;  // boxes of 2^minSkip_ cells a side or smaller are walked (EmptySkip)
+  // A jump asked for by the visitor (jumpOver).
+  bool jump_ = false;
+  int64_t jumpLo_[3] = {0, 0, 0}, jumpHi_[3] = {0, 0, 0};
+  uint64_t jumps_ = 0;
 };
 
 template <int M, class Visit>
@@ -264,6 +288,10 @@ inline bool GridWalker::walkStep(Visit& visit, double tm, WalkCell& cell, WalkSt
   cell.tExit = tm;
   cell.exitSlack = ax_.tol[M] + relSlack;
   if (visit(static_cast<const WalkCell&>(cell))) return false;
+  if (jump_) [[unlikely]] {
+    jump_ = false;
+    if (takeJump(w)) return true;
+  }
   if (pastEnd(M, tm, relSlack) || ++w.steps > maxSteps_) return false;
   constexpr int A1 = M == 0, A2 = 2 - (M == 2);
   const bool n1 = nearAt(A1, w.t[A1], tm, relSlack), n2 = nearAt(A2, w.t[A2], tm, relSlack);
@@ -306,8 +334,21 @@ inline bool GridWalker::visitExtras(Visit& visit, int m, double tm, const WalkCe
   saveState(w);
   const WalkCell from = cell;  // a copy, so that `cell` itself never escapes the registers
   queueExtras(m, tm, from, n1, n2);
-  while (queued_ > 0)
+  while (queued_ > 0) {
     if (visit(static_cast<const WalkCell&>(queue_[--queued_]))) return false;
+    jump_ = false;  // an extra cell's box says nothing of the cells the walk goes on through
+  }
+  return true;
+}
+
+inline bool GridWalker::takeJump(WalkState& w) {
+  saveState(w);
+  const uint64_t before = steps_;
+  fastForwardBox(jumpLo_, jumpHi_);
+  if (steps_ == before) return false;
+  ++jumps_;
+  loadState(w);
+  w.checkBlock = blockSlot_ != nullptr;  // the jump may have entered a new block
   return true;
 }
 
@@ -315,8 +356,10 @@ template <class Visit>
 inline void GridWalker::walk(Visit&& visit) {
   WalkCell cell;
   if (done_ || queued_ > 0 || ax_.divide[0] || ax_.divide[1] || ax_.divide[2]) {
-    while (next(cell))
+    while (next(cell)) {
       if (visit(static_cast<const WalkCell&>(cell))) return;
+      jump_ = false;  // next() has already stepped past the cell: no jump from there
+    }
     return;
   }
   WalkState w;

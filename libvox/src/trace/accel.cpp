@@ -54,8 +54,8 @@ void buildTables(Accel& accel, const Grid& grid) {
   // Smallest block size (4 to 64 cells a side) whose block array stays small: under kMaxBlocks, and for a sparse
   // grid under a few dozen blocks per occupied cell or solid run (a crafted 303137x24624x1 grid of 6 occupied cells
   // took 29M blocks and 1.9 s to build at 4 cells a side; it gets 1.8M at 64).
-  const uint64_t budget = std::min(
-      kMaxBlocks, std::max(kMinBlockBudget, 64 * (uint64_t(grid.cellKeys.size()) + grid.solidRuns.size())));
+  const uint64_t budget =
+      std::min(kMaxBlocks, std::max(kMinBlockBudget, 64 * (uint64_t(grid.cellKeys.size()) + grid.solidRuns.size())));
   uint32_t shift = 0;
   for (uint32_t s = 2; s <= 6 && shift == 0; ++s) {
     uint64_t blocks = 1;

@@ -42,9 +42,7 @@ class OccupiedCounts {
   }
 
  private:
-  uint32_t& at(uint32_t x, uint32_t y, uint32_t z) {
-    return sum_[x + size_t(n_[0] + 1) * (y + size_t(n_[1] + 1) * z)];
-  }
+  uint32_t& at(uint32_t x, uint32_t y, uint32_t z) { return sum_[x + size_t(n_[0] + 1) * (y + size_t(n_[1] + 1) * z)]; }
   uint32_t at(uint32_t x, uint32_t y, uint32_t z) const {
     return sum_[x + size_t(n_[0] + 1) * (y + size_t(n_[1] + 1) * z)];
   }

@@ -66,11 +66,12 @@ vox::Vec3 hitNormal(const vox::Accel& accel, const vox::Ray& ray, const vox::Hit
   return vox::planeNormal(accel.planes[s - accel.sphereCount]);
 }
 
-// The grid walk (kept by the Grid), or the brute force for accel="none" (built for the call into `none`).
-const vox::Accel& accelFor(PyGrid& self, vox::AccelKind kind, std::unique_ptr<vox::Accel>& none) {
+// The grid walk (kept by the Grid), or the uniform walk or brute force for accel="uniform" or "none" (built for the
+// call into `other`).
+const vox::Accel& accelFor(PyGrid& self, vox::AccelKind kind, std::unique_ptr<vox::Accel>& other) {
   if (kind == vox::AccelKind::Grid) return self.accel();
-  none = std::make_unique<vox::Accel>(vox::buildAccel(self.scene(), self.grid(), vox::AccelKind::None));
-  return *none;
+  other = std::make_unique<vox::Accel>(vox::buildAccel(self.scene(), self.grid(), kind));
+  return *other;
 }
 
 py::tuple intersect(PyGrid& self, const py::handle& origins, const py::handle& directions, const py::handle& tmax,
@@ -134,7 +135,8 @@ tmax: a number or (R,) numbers.
 Returns t (R,) float64 (inf for a miss), primitive (R,) int64 (ids in the scene's order: an OBJ's triangles in face
 order, then spheres, then planes; -1 for a miss) and normal (R, 3) float64 (unit geometric normal, not flipped
 towards the ray; zeros for a miss). Planes and primitives outside the grid's bounds are found too.
-accel 'none' tests every primitive for every ray instead (brute force: the reference the walk equals).
+accel 'uniform' steps through every cell the ray crosses (no jumps over empty boxes), 'none' tests every primitive for
+every ray (brute force: the reference the walk equals).
 The trace structure is built on the first call and kept. The GIL is released; Ctrl-C stops it.
 )doc");
   grid.def("occluded", &occludedRays, py::arg("origins"), py::arg("directions"),

@@ -99,8 +99,8 @@ py::array_t<float> render(PyGrid& self, const py::object& size, const std::strin
   };
   Image image = runLong(interrupt, nThreads, [&] {
     if (accelKind == AccelKind::Grid) return traceImage(self.scene(), self.accel(), ro);
-    const Accel none = buildAccel(self.scene(), self.grid(), AccelKind::None);
-    return traceImage(self.scene(), none, ro);
+    const Accel other = buildAccel(self.scene(), self.grid(), accelKind);  // "uniform" or "none"
+    return traceImage(self.scene(), other, ro);
   });
   std::vector<py::ssize_t> shape{py::ssize_t(image.height), py::ssize_t(image.width)};
   if (image.channels != 1) shape.push_back(py::ssize_t(image.channels));
@@ -141,7 +141,7 @@ The image vox-trace renders, pixel for pixel, as float32: (H, W, 3) linear RGB f
 the top; size is (width, height). The options are vox-trace's: samples per pixel (jittered), bounces and weight
 (reflection and refraction), shade_back, shadows (False: --no-shadows), filter=(kind, radius) ('box', 'tent',
 'gaussian'; pixels); eye and look_at (a perspective camera replacing the scene's), up, fov (vertical, degrees);
-accel 'grid' or 'none' (brute force, the same image). Without a camera in the scene, one framing the grid; without
+accel 'grid', 'uniform' (every cell crossed) or 'none' (brute force), the same image. Without a camera in the scene, one framing the grid; without
 lights, a headlight. The GIL is released; Ctrl-C stops it. Write the result with libvox.save_image.
 )doc");
   m.def("save_image", &saveImage, py::arg("path"), py::arg("image"), R"doc(

@@ -65,6 +65,10 @@ def test_intersect_equals_brute_force(scene, method):
                           grid.intersect(origins, directions, below, accel="none")[1][hit] >= 0)
     assert np.array_equal(grid.occluded(origins, directions), grid.occluded(origins, directions, accel="none"))
     assert np.array_equal(grid.occluded(origins, directions), hit)
+    # The uniform walk (every cell crossed, no jumps over empty boxes) gives the same answers.
+    tu, pu, nu = grid.intersect(origins, directions, accel="uniform")
+    assert np.array_equal(t, tu) and np.array_equal(prim, pu) and np.array_equal(normal, nu)
+    assert np.array_equal(grid.occluded(origins, directions, accel="uniform"), hit)
 
 
 def test_intersect_threads_and_shapes():

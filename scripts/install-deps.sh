@@ -17,7 +17,7 @@ command -v npm >/dev/null || packages+=(npm)
 for arg in "$@"; do
   case $arg in
     # bench/python_bench.py compares with Open3D (Debian's 0.16) and draws its bars with tqdm.
-    --bench) packages+=(libbenchmark-dev libembree-dev python3-open3d python3-tqdm) ;;
+    --bench) packages+=(libbenchmark-dev libembree-dev python3-open3d python3-tqdm python3-matplotlib) ;;
     --meshlab) packages+=(meshlab xvfb xauth) ;;
     # Real clients of exported meshes (tests/cli/export_*.sh); numpy for Blender's glTF importer.
     # python3-openvdb (pyopenvdb) reads exported .vdb files back (tests/cli/export_voxel_formats.sh).

@@ -19,6 +19,9 @@
 #include "vox/io/info.h"
 #include "vox/io/input_file.h"
 #include "vox/import/import.h"
+#include "vox/sets/fill_set.h"
+#include "vox/sets/voxelize_set.h"
+#include "vox/voxelize/bricks.h"
 
 namespace vox {
 namespace {

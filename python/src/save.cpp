@@ -9,6 +9,7 @@
 #include "vox/io/atomic_file.h"
 #include "vox/io/grid_set.h"
 #include "vox/io/input_file.h"
+#include "vox/sets/voxelize_set.h"
 #include "vox/voxelize/bricks.h"
 
 namespace voxpy {

@@ -15,6 +15,7 @@
 #include "vox/io/input_file.h"
 #include "vox/core/progress.h"
 #include "vox/core/tool.h"
+#include "vox/sets/voxelize_set.h"
 #include "vox/voxelize/voxelize.h"
 
 namespace {

@@ -17,16 +17,6 @@ inline constexpr size_t kSetHeaderSize = 32;
 inline constexpr char kSetMagic[8] = {'V', 'O', 'X', 'G', 'S', 'E', 'T', '\n'};
 inline constexpr char kBrickMagic[8] = {'V', 'O', 'X', 'B', 'R', 'C', 'K', '\n'};
 
-// A grid without cells on the plan of `plan` (a Grid or a GridSetManifest: both carry bounds, dims and method).
-template <typename Plan>
-Grid emptyGridLike(const Plan& plan) {
-  Grid g;
-  g.bounds = plan.bounds;
-  g.dims = plan.dims;
-  g.method = plan.method;
-  return g;
-}
-
 // True when `name` holds a control byte (below 0x20, or DEL). Names are printed in one-line errors, which a newline
 // would split: readers refuse such names in a manifest, and the writer refuses to make them.
 inline bool hasControlByte(const std::string& name) {

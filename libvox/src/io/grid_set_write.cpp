@@ -1,6 +1,6 @@
-// Writing a grid set: a generation folder of its own, the scene file first, then each brick voxelized and written
-// before the next starts (so one brick's cells are in memory at a time), the fill's solid runs, the manifest last
-// (so a failure anywhere leaves the old set, or none), then the old set's files removed.
+// Writing a grid set's files: a generation folder of its own, the scene file, brick files, the manifest last (so a
+// failure anywhere leaves the old set, or none), then the old set's files removed. What goes into the bricks is the
+// sets stage's (sets/voxelize_set.cpp, sets/fill_set.cpp).
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -188,25 +188,6 @@ BrickEntry writeBrickFile(const std::string& setPath, const GridSetManifest& set
   return e;
 }
 
-BrickEntry writeBrick(const std::string& setPath, const GridSetManifest& set, const Scene& scene, const Grid& plan,
-                      const std::array<uint32_t, 3>& index, std::span<const uint32_t> candidates,
-                      const VoxelizeOptions& options, VoxelizeStats* stats) {
-  VoxelizeStats brickStats;
-  const Grid grid =
-      voxelizeBrick(scene, plan, brickWindow(plan.dims, set.bricks, index), candidates, options, &brickStats);
-  if (stats) {
-    stats->cellsTested += brickStats.cellsTested;
-    stats->exactFallbacks += brickStats.exactFallbacks;
-    stats->seconds += brickStats.seconds;
-  }
-  if (grid.occupiedCount() == 0) {
-    BrickEntry e;
-    e.index = index;
-    return e;
-  }
-  return writeBrickFile(setPath, set, index, grid);
-}
-
 void writeGridSetManifest(const std::string& setPath, const GridSetManifest& manifest) {
   GridSetManifest m = manifest;
   std::erase_if(m.entries, [](const BrickEntry& e) { return e.occupied == 0 && e.solid == 0; });
@@ -214,35 +195,6 @@ void writeGridSetManifest(const std::string& setPath, const GridSetManifest& man
     return brickNumber(m.bricks, a.index) < brickNumber(m.bricks, b.index);
   });
   writeFileAtomically(setPath, encodeGridSetManifest(m));
-}
-
-GridSetManifest writeGridSet(const std::string& setPath, const Scene& scene, const VoxelizeOptions& options,
-                             const std::array<uint32_t, 3>& bricks, VoxelizeStats* stats, const FillOptions* fill,
-                             FillReport* fillReport) {
-  checkGridSetOutput(setPath);  // before any work
-  Grid plan = planGrid(scene, options);
-  checkBrickCounts(plan.dims, bricks);
-  if (options.bounds) plan.outsidePrims = primitivesOutside(scene, plan);
-  const auto candidates = brickCandidates(scene, plan, bricks, options.memoryLimitBytes);
-  GridSetOutput output(setPath);
-  GridSetManifest m{
-      plan.bounds, plan.dims, plan.method, bricks, writeGridSetScene(setPath, output.folder(), scene, plan), {}};
-  VoxelizeOptions brickOptions = options;
-  brickOptions.progress = nullptr;
-  for (uint64_t b = 0; b < candidates.size(); ++b) {
-    if (options.progress && !options.progress(double(b) / double(candidates.size())))
-      fail<Error>("voxelization cancelled");
-    if (candidates[b].empty()) continue;
-    const BrickEntry e = writeBrick(setPath, m, scene, plan, brickIndex(bricks, b), candidates[b], brickOptions, stats);
-    if (e.occupied > 0) m.entries.push_back(e);
-  }
-  if (options.progress) options.progress(1.0);
-  if (fill) {
-    const FillReport report = fillGridSet(setPath, m, scene, *fill);
-    if (fillReport) *fillReport = report;
-  }
-  output.commit(m);
-  return m;
 }
 
 }  // namespace vox

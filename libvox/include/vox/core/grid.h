@@ -19,6 +19,8 @@ struct CellRun {
   uint64_t count = 0;
 };
 
+inline constexpr uint32_t kMaxCellsPerAxis = 1u << 21;  // keeps every cell key below 2^63
+
 enum class OverlapMethod : uint8_t { Center = 0, BBox = 1, Sat = 2, Exact = 3 };
 
 std::string methodName(OverlapMethod method);

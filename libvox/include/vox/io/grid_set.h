@@ -1,6 +1,7 @@
 // Grid sets (issue 13): one grid split into bricks of whole cells. The scene is stored once, in a scene file; each
 // non-empty brick is a brick file holding only its cells, primitive lists and solid runs; a small checksummed
-// manifest names them all. Layout in docs/grid-format.md "Grid sets".
+// manifest names them all. Layout in docs/grid-format.md "Grid sets". The files only: voxelizing a scene into a set
+// and filling one are the sets stage's (vox/sets/).
 #pragma once
 
 #include <array>
@@ -11,11 +12,9 @@
 #include <string>
 #include <vector>
 
+#include "vox/core/brick_layout.h"
 #include "vox/io/atomic_file.h"
 #include "vox/io/grid_file.h"
-#include "vox/voxelize/bricks.h"
-#include "vox/voxelize/fill.h"
-#include "vox/voxelize/voxelize.h"
 
 namespace vox {
 
@@ -52,6 +51,16 @@ struct GridSetManifest {
   GridSetScene scene;
   std::vector<BrickEntry> entries;
 };
+
+// A grid without cells on the plan of `plan` (a Grid or a GridSetManifest: both carry bounds, dims and method).
+template <typename Plan>
+Grid emptyGridLike(const Plan& plan) {
+  Grid g;
+  g.bounds = plan.bounds;
+  g.dims = plan.dims;
+  g.method = plan.method;
+  return g;
+}
 
 // ---- Writing ----
 // A set is replaced as a whole or not at all. Its files go into a generation folder of their own,
@@ -111,34 +120,9 @@ GridSetScene writeGridSetScene(const std::string& setPath, const std::string& fo
 BrickEntry writeBrickFile(const std::string& setPath, const GridSetManifest& set, const std::array<uint32_t, 3>& index,
                           const Grid& cells);
 
-// Voxelizes brick `index` of the planned grid and, when it has occupied cells, writes its brick file. Returns its
-// entry; occupied == 0 means nothing was written. `set` gives the plan, the brick counts and the scene file.
-// Throws as voxelizeBrick and OutputError.
-BrickEntry writeBrick(const std::string& setPath, const GridSetManifest& set, const Scene& scene, const Grid& plan,
-                      const std::array<uint32_t, 3>& index, std::span<const uint32_t> candidates,
-                      const VoxelizeOptions& options, VoxelizeStats* stats = nullptr);
-
-// --fill for a set whose bricks are written, in memory bounded by a brick rather than the grid: fills the set's
-// occupied cells in slabs of whole planes (SlabFill, options.slabCells cells a slab), so that the solid cells are
-// the single grid's, run for run. Reads the bricks one layer (bz) at a time, twice, keeping a layer's cell keys
-// delta-coded (1 to 2 bytes a cell of a surface) and one slab's keys and scratch. After a layer's second reading,
-// its solid runs are split by brick and the bricks holding solid cells rewritten (new ones written for bricks
-// holding only solid cells). Updates set.entries (ascending). Throws as fillSolid, InputError for a corrupt brick,
-// OutputError.
-FillReport fillGridSet(const std::string& setPath, GridSetManifest& set, const Scene& scene,
-                       const FillOptions& options);
-
 // Writes the manifest (atomically: a failure leaves the old one). Entries without cells are left out. Prefer
 // GridSetOutput::commit, which also removes the replaced set's files.
 void writeGridSetManifest(const std::string& setPath, const GridSetManifest& manifest);
-
-// The whole job on one process: the output checked, plan, scene file, candidates, each brick voxelized and written
-// before the next starts, the fill when `fill` is given (its report in `fillReport`), then the manifest, through a
-// GridSetOutput (a failure or cancel leaves the old set whole). `progress` (may be empty)
-// gets the fraction of bricks done. Returns the manifest written.
-GridSetManifest writeGridSet(const std::string& setPath, const Scene& scene, const VoxelizeOptions& options,
-                             const std::array<uint32_t, 3>& bricks, VoxelizeStats* stats = nullptr,
-                             const FillOptions* fill = nullptr, FillReport* fillReport = nullptr);
 
 // ---- Reading ----
 

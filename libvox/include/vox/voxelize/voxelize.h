@@ -8,6 +8,7 @@
 #include <span>
 #include <vector>
 
+#include "vox/core/brick_layout.h"
 #include "vox/core/grid.h"
 #include "vox/core/scene.h"
 
@@ -30,7 +31,6 @@ struct VoxelizeStats {
   double seconds = 0;  // time in voxelization alone
 };
 
-inline constexpr uint32_t kMaxCellsPerAxis = 1u << 21;  // keeps every cell key below 2^63
 // Chosen from the resolution sweep of bench/tradeoff.sh (docs/tradeoff.md): the fastest exact grids for tracing the
 // meshes had 1.3 to 5 cells per primitive (median 3); at 3 the default traced within 6% of the best swept
 // resolution on 8 of 9 scenes (1.7x on SheenCloth).
@@ -44,12 +44,6 @@ Grid planGrid(const Scene& scene, const VoxelizeOptions& options);
 // Dimensions chosen by the default heuristic: about kCellsPerPrimitive cells per bounded primitive, cubic cells.
 std::array<uint32_t, 3> defaultDims(const Box& bounds, size_t boundedPrimitives);
 std::array<uint32_t, 3> dimsForResolution(const Box& bounds, uint32_t resolution);
-
-// A box of whole cells: first[a] <= i < end[a] on each axis a (a brick of a grid set).
-struct CellWindow {
-  std::array<uint32_t, 3> first{0, 0, 0};
-  std::array<uint32_t, 3> end{1, 1, 1};
-};
 
 // The bounded primitives whose bounding boxes stick out of grid.bounds, ascending (what voxelizeScene puts in
 // grid.outsidePrims when the bounds are the user's).

@@ -1,10 +1,11 @@
 // --fill over a grid set (fillGridSet): the single grid's fill, decided slab by slab (SlabFill) from the bricks' cell
 // keys, in memory bounded by a layer of bricks' keys delta-coded, one brick and one slab rather than the grid.
+#include "vox/sets/fill_set.h"
+
 #include <algorithm>
 #include <cstring>
-
-#include "io/grid_set_header.h"
-#include "vox/io/grid_set.h"
+#include <span>
+#include <vector>
 
 namespace vox {
 

@@ -5,17 +5,17 @@
 
 #include <mpi.h>
 
-#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <functional>
 #include <thread>
 
+#include "work_counter.h"
+
 namespace vox::mpi {
 
 inline constexpr int kTagRequest = 701;
 inline constexpr int kTagItem = 702;
-inline constexpr uint64_t kNoMoreItems = ~uint64_t(0);
 
 // Runs work(i) for items i taken from [0, count) until none is left. work returns false after a failure: the rank
 // then stops, and every rank is handed no more items (a failing rank fails the run, so the rest is not worth doing).
@@ -26,13 +26,7 @@ inline void runWorkQueue(MPI_Comm comm, uint64_t count, const std::function<bool
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
   if (rank == 0) {
-    std::atomic<uint64_t> next{0};
-    std::atomic<bool> stop{false};
-    auto take = [&]() -> uint64_t {
-      if (stop.load()) return kNoMoreItems;
-      const uint64_t i = next.fetch_add(1);
-      return i < count ? i : kNoMoreItems;
-    };
+    WorkCounter counter(count);
     std::thread helper;
     if (size > 1)
       helper = std::thread([&] {
@@ -48,14 +42,14 @@ inline void runWorkQueue(MPI_Comm comm, uint64_t count, const std::function<bool
           }
           int failed = 0;
           MPI_Recv(&failed, 1, MPI_INT, status.MPI_SOURCE, kTagRequest, comm, MPI_STATUS_IGNORE);
-          if (failed) stop = true;
-          const uint64_t item = take();
+          if (failed) counter.stop();
+          const uint64_t item = counter.take();
           MPI_Send(&item, 1, MPI_UINT64_T, status.MPI_SOURCE, kTagItem, comm);
           if (item == kNoMoreItems) --open;
         }
       });
-    for (uint64_t i = take(); i != kNoMoreItems; i = take())
-      if (!work(i)) stop = true;
+    for (uint64_t i = counter.take(); i != kNoMoreItems; i = counter.take())
+      if (!work(i)) counter.stop();
     if (helper.joinable()) helper.join();
     return;
   }

@@ -1,0 +1,46 @@
+#include "options.h"
+
+#include "vox/core/memory_budget.h"
+
+namespace vox::voxelize_tool {
+
+void addOptions(CLI::App& app, Options& opt) {
+  app.add_option("scene", opt.scene, "Input scene file")->required();
+  app.add_option("-o,--output", opt.output, "Output grid file (.vgrid)")->required();
+  auto* grid = app.add_option("--grid", opt.grid, "Grid dimensions NX NY NZ")->expected(3);
+  auto* res = app.add_option("--res", opt.resolution, "Cells on the longest axis; cells kept as cubic as possible");
+  grid->excludes(res);
+  app.add_option("--bounds", opt.bounds, "Grid bounds X0 Y0 Z0 X1 Y1 Z1 (default: the scene's bounded primitives)")
+      ->expected(6);
+  app.add_option("--method", opt.method,
+                 "Overlap test: exact (CGAL exact predicates, default), sat (floating-point separating axes), "
+                 "bbox (primitive bounding box, superset), center (cell centre in footprint, misses cells)")
+      ->check(CLI::IsMember({"exact", "sat", "bbox", "center"}));
+  app.add_flag("--fill", opt.fill,
+               "Also mark the empty cells inside the surfaces as solid: flood fill for closed meshes, |winding "
+               "number| >= 0.5 for open ones; says which on stderr");
+  app.add_option("--bricks", opt.bricks,
+                 "Write a grid set: OUT is a manifest naming the scene file and one brick file per non-empty brick "
+                 "of BX x BY x BZ bricks (in a new folder OUT_NAME.bricks/gHEX/ beside it; the old set is removed once "
+                 "the new one is in place), voxelized one brick at a time; with "
+                 "--fill, the fill runs over all bricks' cells afterwards")
+      ->expected(3)
+      ->check(CLI::Range(1u, kMaxCellsPerAxis));
+  app.add_flag("--stats", opt.stats, "Print statistics (name: value) on stderr");
+  cli::addCommonOptions(app, opt.common);
+  app.footer("Default grid: about " + std::to_string(int(kCellsPerPrimitive)) +
+             " cells per bounded primitive, cubic cells. Exit codes: 0 ok, 1 usage, 2 bad input, 3 cannot write.");
+}
+
+VoxelizeOptions voxelizeOptions(const Options& opt) {
+  VoxelizeOptions vo;
+  vo.method = parseMethod(opt.method);
+  if (!opt.grid.empty()) vo.dims = std::array<uint32_t, 3>{opt.grid[0], opt.grid[1], opt.grid[2]};
+  if (opt.resolution) vo.resolution = opt.resolution;
+  if (!opt.bounds.empty())
+    vo.bounds = Box{{opt.bounds[0], opt.bounds[1], opt.bounds[2]}, {opt.bounds[3], opt.bounds[4], opt.bounds[5]}};
+  vo.memoryLimitBytes = memoryBudgetBytes();
+  return vo;
+}
+
+}  // namespace vox::voxelize_tool

@@ -1,0 +1,34 @@
+// vox-voxelize's command line: the options parsed into a struct and the voxelizer's options taken from it.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "../common/cli.h"
+#include "vox/voxelize/voxelize.h"
+
+namespace vox::voxelize_tool {
+
+struct Options {
+  std::string scene;
+  std::string output;
+  std::vector<uint32_t> grid;
+  uint32_t resolution = 0;
+  std::vector<double> bounds;
+  std::string method = "exact";
+  bool stats = false;
+  bool fill = false;
+  std::vector<uint32_t> bricks;  // --bricks BX BY BZ: write a grid set
+  cli::CommonOptions common;
+};
+
+// Adds the tool's positional argument, options and flags to `app`, bound to `opt`, with the help's footer.
+void addOptions(CLI::App& app, Options& opt);
+
+// The voxelizer's options: method, --grid or --res, --bounds, and the memory budget. Throws InputError for an
+// unknown method (CLI11 has refused it before).
+VoxelizeOptions voxelizeOptions(const Options& opt);
+
+}  // namespace vox::voxelize_tool

@@ -1,0 +1,24 @@
+// vox-export's command line: the options parsed into a struct.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "../common/cli.h"
+
+namespace vox::export_tool {
+
+struct Options {
+  std::string grid;
+  std::string output;
+  std::string faces = "exposed";
+  std::string color = "count";
+  bool ascii = false;
+  bool stats = false;
+  cli::CommonOptions common;
+};
+
+// Adds the tool's positional argument, options and flags to `app`, bound to `opt`, with the help's footer.
+void addOptions(CLI::App& app, Options& opt);
+
+}  // namespace vox::export_tool

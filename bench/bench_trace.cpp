@@ -158,7 +158,7 @@ std::array<uint32_t, 3> dimsForFactor(const vox::Box& b, size_t triangles, doubl
   return d;
 }
 
-// Primary rays at each cells-per-triangle factor (the table of README's Tracing paragraph).
+// Primary rays at each cells-per-triangle factor (the table of docs/speed.md, "Tracing primary rays").
 void benchPrimary(const std::string& path, unsigned threads, uint32_t size, int reps,
                   const std::vector<double>& factors) {
   const vox::Scene scene = vox::loadScene(path);

@@ -1,4 +1,4 @@
-// Makes the README's picture of the viewer page (docs/images/viewer_duck.png): the Duck (seed glTF) at --res 64 with
+// Makes the picture of the viewer page in docs/vox-export.md (docs/images/viewer_duck.png): the Duck (seed glTF) at --res 64 with
 // its texture colours, sliced at x < 34, cell lines on, one cell pinned; headless Chromium as in tests/viewer/.
 // Usage: node scripts/viewer-screenshot.mjs BUILD_DIR SOURCE_DIR
 import { writeFileSync } from 'node:fs';

@@ -7,7 +7,7 @@
 #    no edge with more than two faces, and colours (PLY: a colour attribute; OBJ: one material per colour);
 #  - glTF: colours (one material per colour) and all triangles; closed when it has a single colour. Blender's
 #    glTF importer gives every primitive its own vertices, so a glTF of several colours opens along the colour
-#    seams in Blender (boundary edges are printed, not checked; README, "Clients").
+#    seams in Blender (boundary edges are printed, not checked; docs/vox-export.md, "Meshes").
 # Debian 12's Blender glTF add-on needs `numpy.bool = bool` (blender_import.py sets it): its bug with numpy 1.24,
 # not ours. One Blender run imports every file (Blender starts in about 2 s). Skips (exit 0) when blender is
 # missing; CI installs it (scripts/install-deps.sh --clients).

@@ -179,7 +179,7 @@ TEST(GridFile, SolidRunsRoundTripAndVersion1KeysStillRead) {
   VoxelizeOptions opt;
   opt.dims = {7, 5, 3};
   Grid grid = voxelizeScene(scene, opt);
-  const std::string plain = encodeGridFile(scene, grid);
+  const std::string plain = encodeGridFile(scene, grid, 2);
   // Keys 3,4,5 and 9 and the last cell: runs {3,3}, {9,1}, {104,1}; one run crossing a row boundary (6, 7).
   const std::vector<uint64_t> keys = {3, 4, 5, 6, 7, 9, 104};
   for (uint64_t k : keys) appendSolidKey(grid.solidRuns, k);
@@ -296,11 +296,13 @@ TEST(GridFile, MutationsWithValidChecksumDecodeOrThrow) {
   const Scene scene = sampleScene();
   VoxelizeOptions opt;
   opt.dims = {4, 3, 5};
-  const std::string bytes = encodeGridFile(scene, voxelizeScene(scene, opt));
+  const Grid grid = voxelizeScene(scene, opt);
+  const std::string v3 = encodeGridFile(scene, grid), v2 = encodeGridFile(scene, grid, 2);
   std::mt19937 rng(17);
   int refused = 0, accepted = 0;
-  for (int n = 0; n < 20000; ++n) {
-    std::string m = bytes;
+  // The current version's cell table (varints), then version 2's flat arrays, which old files still have.
+  for (int n = 0; n < 25000; ++n) {
+    std::string m = n < 20000 ? v3 : v2;
     const int edits = 1 + int(rng() % 4);
     for (int e = 0; e < edits; ++e) {
       const size_t at = 32 + rng() % (m.size() - 32);

@@ -122,6 +122,13 @@ class ByteReader {
     pos_ += n * sizeof(T);
     return values;
   }
+  // The next n bytes, uncopied (they live as long as the reader's bytes).
+  std::string_view take(uint64_t n) {
+    need(n);
+    const std::string_view bytes(data_.data() + pos_, n);
+    pos_ += n;
+    return bytes;
+  }
   size_t position() const { return pos_; }
   const std::string& name() const { return name_; }
   bool atEnd() const { return pos_ == data_.size(); }
@@ -129,7 +136,7 @@ class ByteReader {
  private:
   const std::string& data_;
   size_t pos_;
-  const std::string& name_;
+  std::string name_;  // a copy: callers pass literals and temporaries
 };
 
 }  // namespace vox

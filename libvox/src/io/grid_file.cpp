@@ -11,6 +11,7 @@
 #include "vox/core/error.h"
 #include "vox/io/input_file.h"
 #include "io/byte_codec.h"
+#include "io/grid_cell_table.h"
 #include "io/grid_sections.h"
 
 static_assert(std::endian::native == std::endian::little,
@@ -149,8 +150,10 @@ uint64_t gridChecksum(const char* payload, size_t size) { return wordChecksum(pa
 
 namespace {
 
-// The payload of docs/grid-format.md (everything after the 32-byte header).
-void encodePayload(ByteWriter& w, const Scene& scene, const Grid& grid) {
+// The payload of docs/grid-format.md (everything after the 32-byte header), in `version` 3 (the cell table in
+// `table`) or 2 (the flat arrays: tests of old files).
+void encodePayload(ByteWriter& w, const Scene& scene, const Grid& grid, const EncodedCellTable& table,
+                   uint32_t version) {
   // Scene.
   w.put(uint64_t(scene.materials.size()));
   for (const auto& m : scene.materials) putMaterial(w, m);
@@ -198,17 +201,21 @@ void encodePayload(ByteWriter& w, const Scene& scene, const Grid& grid) {
   w.putVec(grid.bounds.hi);
   for (uint32_t n : grid.dims) w.put(n);
   w.put(uint8_t(grid.method));
-  w.putArray(grid.cellKeys);
-  w.putArray(grid.cellStart);
-  w.putArray(grid.primIds);
+  if (version >= 3) {
+    putCellTable(w, table);
+  } else {
+    w.putArray(grid.cellKeys);
+    w.putArray(grid.cellStart);
+    w.putArray(grid.primIds);
+  }
   w.putArray(grid.outsidePrims);
   w.putArray(grid.solidRuns);
   putSections(w, scene, grid);
 }
 
-std::string encodeHeader(uint64_t payloadSize, uint64_t checksum) {
+std::string encodeHeader(uint64_t payloadSize, uint64_t checksum, uint32_t version = kGridFileVersion) {
   std::string header(kHeaderSize, '\0');
-  const uint32_t version = kGridFileVersion, flags = 0;
+  const uint32_t flags = 0;
   std::memcpy(header.data(), kMagic, 8);
   std::memcpy(header.data() + 8, &version, 4);
   std::memcpy(header.data() + 12, &flags, 4);
@@ -218,23 +225,25 @@ std::string encodeHeader(uint64_t payloadSize, uint64_t checksum) {
 }
 
 // Runs the encoder with every byte going to `sink`.
-void streamPayload(const Scene& scene, const Grid& grid, const ByteWriter::Sink& sink) {
+void streamPayload(const Scene& scene, const Grid& grid, const EncodedCellTable& table, const ByteWriter::Sink& sink) {
   ByteWriter w(sink);
-  encodePayload(w, scene, grid);
+  encodePayload(w, scene, grid, table, kGridFileVersion);
   w.finish();
 }
 
 }  // namespace
 
-std::string encodeGridFile(const Scene& scene, const Grid& grid) {
+std::string encodeGridFile(const Scene& scene, const Grid& grid, uint32_t version) {
+  if (version < 2 || version > kGridFileVersion) fail<UsageError>("cannot write grid file version ", version);
+  const EncodedCellTable table = version >= 3 ? encodeCellTable(grid) : EncodedCellTable{};
+  const uint64_t cellBytes = version >= 3 ? table.bytes.size() : grid.cellKeys.size() * 16 + grid.primIds.size() * 4;
   ByteWriter w;
-  w.bytes().reserve(kHeaderSize + 256 + scene.triangles.size() * 76 + grid.cellKeys.size() * 16 +
-                    grid.primIds.size() * 4 + scene.materials.size() * 128);
+  w.bytes().reserve(kHeaderSize + 256 + scene.triangles.size() * 76 + cellBytes + scene.materials.size() * 128);
   w.bytes().assign(kHeaderSize, '\0');  // the header is filled in last, in place, so the payload is never copied
-  encodePayload(w, scene, grid);
+  encodePayload(w, scene, grid, table, version);
   std::string bytes = std::move(w.bytes());
   const uint64_t payloadSize = bytes.size() - kHeaderSize;
-  const std::string header = encodeHeader(payloadSize, wordChecksum(bytes.data() + kHeaderSize, payloadSize));
+  const std::string header = encodeHeader(payloadSize, wordChecksum(bytes.data() + kHeaderSize, payloadSize), version);
   std::memcpy(bytes.data(), header.data(), kHeaderSize);
   return bytes;
 }
@@ -343,9 +352,10 @@ void getGridShape(ByteReader& r, Grid& grid) {
   grid.method = OverlapMethod(method);
 }
 
-// Structural checks of the cell table read at byte `cellsAt`: sorted unique keys inside the grid, offsets that
-// partition the references, ids below `bounded` (the triangles and spheres).
-void checkCellTable(const Grid& grid, uint64_t bounded, const std::string& name, size_t cellsAt) {
+// Structural checks of a version 1 or 2 cell table read at byte `cellsAt` (version 3's decoder checks the same as
+// it reads): sorted unique keys inside the grid, offsets that partition the references, ids below `bounded` (the
+// triangles and spheres).
+void checkFlatCellTable(const Grid& grid, uint64_t bounded, const std::string& name, size_t cellsAt) {
   auto bad = [&](const std::string& what) { fail<InputError>(name, ": cell table at byte ", cellsAt, ": ", what); };
   const uint64_t cells = grid.cellCount();
   for (size_t c = 0; c < grid.cellKeys.size(); ++c)
@@ -364,8 +374,6 @@ void checkCellTable(const Grid& grid, uint64_t bounded, const std::string& name,
       if (grid.primIds[k] >= bounded || (k > grid.cellStart[c] && grid.primIds[k] <= grid.primIds[k - 1]))
         bad("primitive ids not ascending or out of range");
   }
-  for (uint32_t id : grid.outsidePrims)
-    if (id >= bounded) bad("outside primitive id out of range");
 }
 
 }  // namespace
@@ -380,11 +388,19 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
   Grid& grid = out.grid;
   getGridShape(r, grid);
 
+  const uint64_t bounded = scene.triangles.size() + scene.spheres.size();
   const size_t cellsAt = r.position();
-  grid.cellKeys = r.getArray<uint64_t>("cell");
-  grid.cellStart = r.getArray<uint64_t>("cell start");
-  grid.primIds = r.getArray<uint32_t>("reference");
+  if (version >= 3) {
+    getCellTable(r, grid, bounded);
+  } else {
+    grid.cellKeys = r.getArray<uint64_t>("cell");
+    grid.cellStart = r.getArray<uint64_t>("cell start");
+    grid.primIds = r.getArray<uint32_t>("reference");
+  }
+  const size_t outsideAt = r.position();
   grid.outsidePrims = r.getArray<uint32_t>("outside primitive");
+  for (uint32_t id : grid.outsidePrims)
+    if (id >= bounded) fail<InputError>(name, ": byte ", outsideAt, ": outside primitive id out of range");
   const uint64_t cells = grid.cellCount();
   if (version == 1) {
     grid.solidRuns = getSolidKeysAsRuns(r, cells);
@@ -395,7 +411,7 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
     checkSolidRuns(grid.solidRuns, cells, name + ": solid runs at byte " + std::to_string(runsAt));
     getSections(r, scene, grid);
   }
-  checkCellTable(grid, scene.triangles.size() + scene.spheres.size(), name, cellsAt);
+  if (version < 3) checkFlatCellTable(grid, bounded, name, cellsAt);
   checkSolidRunsMissCells(grid.cellKeys, grid.solidRuns, name + ": solid runs");
   // The same checks as at import (singular ellipsoid transforms, cameras that cannot form an image, materials),
   // so a grid file that passes here traces and exports.
@@ -408,13 +424,15 @@ void writeGridFile(const std::string& path, const Scene& scene, const Grid& grid
   const auto start = Clock::now();
   // Three passes over the encoding instead of the whole file in memory (at 1024^3 the file is as large as the grid):
   // the size, which seeds the checksum; the checksum; then the bytes, header first, through a temporary file.
+  // The cell table, the bulk of the file, is encoded once.
+  const EncodedCellTable table = encodeCellTable(grid);
   uint64_t size = 0;
-  streamPayload(scene, grid, [&](std::string_view bytes) { size += bytes.size(); });
+  streamPayload(scene, grid, table, [&](std::string_view bytes) { size += bytes.size(); });
   ChecksumStream sum(size);
-  streamPayload(scene, grid, [&](std::string_view bytes) { sum.update(bytes); });
+  streamPayload(scene, grid, table, [&](std::string_view bytes) { sum.update(bytes); });
   OutputFile out(path);
   out.write(encodeHeader(size, sum.value()));
-  streamPayload(scene, grid, [&](std::string_view bytes) { out.write(bytes); });
+  streamPayload(scene, grid, table, [&](std::string_view bytes) { out.write(bytes); });
   out.flush();
   const auto written = Clock::now();
   out.commit();

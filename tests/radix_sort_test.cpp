@@ -30,14 +30,42 @@ TEST(RadixSort, PartsSortLikeStdSortOfTheirConcatenation) {
         all.insert(all.end(), parts[p].begin(), parts[p].end());
       }
       std::vector<std::span<const uint64_t>> spans(parts.begin(), parts.end());
-      const auto [sorted, n] = radixSortParts(spans, bits);
       std::sort(all.begin(), all.end());
-      ASSERT_EQ(n, all.size());
-      EXPECT_TRUE(std::equal(all.begin(), all.end(), sorted.get())) << bits << " bits, " << nParts << " parts";
+      // On one thread, and through the parallel path (top digit, then each bucket) whatever the size.
+      for (const size_t parallelFrom : {kParallelSortFrom, size_t(0)}) {
+        const auto [sorted, n] = radixSortParts(spans, bits, parallelFrom);
+        ASSERT_EQ(n, all.size());
+        EXPECT_TRUE(std::equal(all.begin(), all.end(), sorted.get()))
+            << bits << " bits, " << nParts << " parts, parallel from " << parallelFrom;
+      }
     }
   }
   const auto [none, n] = radixSortParts({}, 40);
   EXPECT_EQ(n, 0u);
+}
+
+TEST(RadixSort, LargeInputsOnTheParallelPath) {
+  // Past kParallelSortFrom: blocks of the top-digit pass straddle parts, buckets large enough for LSD passes and
+  // small enough for the comparison sort, keys crowded into a few buckets (a grid's references are).
+  std::mt19937_64 rng(9);
+  for (int bits : {20, 47, 64}) {
+    std::vector<std::vector<uint64_t>> parts(3);
+    std::vector<uint64_t> all;
+    const uint64_t mask = bits == 64 ? ~uint64_t(0) : (uint64_t(1) << bits) - 1;
+    for (size_t p = 0; p < parts.size(); ++p) {
+      const size_t count = 70000 + 30000 * p;
+      for (size_t i = 0; i < count; ++i) {
+        const uint64_t k = rng() & mask;
+        parts[p].push_back(i % 3 == 0 ? k : k >> (bits / 2));  // two thirds in the lowest buckets
+      }
+      all.insert(all.end(), parts[p].begin(), parts[p].end());
+    }
+    std::vector<std::span<const uint64_t>> spans(parts.begin(), parts.end());
+    const auto [sorted, n] = radixSortParts(spans, bits);
+    std::sort(all.begin(), all.end());
+    ASSERT_EQ(n, all.size());
+    EXPECT_TRUE(std::equal(all.begin(), all.end(), sorted.get())) << bits << " bits";
+  }
 }
 
 TEST(RadixSort, GridsDoNotDependOnTheThreadCount) {

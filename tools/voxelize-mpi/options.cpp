@@ -1,6 +1,6 @@
 #include "options.h"
 
-#include "vox/core/memory_budget.h"
+#include "../common/grid_flags.h"
 
 namespace vox::mpi {
 
@@ -36,14 +36,7 @@ std::string modeError(const Options& opt) {
 }
 
 VoxelizeOptions voxelizeOptions(const Options& opt) {
-  VoxelizeOptions vo;
-  vo.method = parseMethod(opt.method);
-  if (!opt.grid.empty()) vo.dims = std::array<uint32_t, 3>{opt.grid[0], opt.grid[1], opt.grid[2]};
-  if (opt.resolution) vo.resolution = opt.resolution;
-  if (!opt.bounds.empty())
-    vo.bounds = Box{{opt.bounds[0], opt.bounds[1], opt.bounds[2]}, {opt.bounds[3], opt.bounds[4], opt.bounds[5]}};
-  vo.memoryLimitBytes = memoryBudgetBytes();
-  return vo;
+  return cli::voxelizeOptionsFromFlags(opt.method, opt.grid, opt.resolution, opt.bounds);
 }
 
 }  // namespace vox::mpi

@@ -11,16 +11,16 @@ const viewerSrc = (name) => pathToFileURL(join(source, 'viewer', 'src', name)).h
 const { decodeViewerData, layoutFromElements, LayoutError } = await import(viewerSrc('data.js'));
 const { Cells } = await import(viewerSrc('cells.js'));
 const { blockSurface } = await import(viewerSrc('lod.js'));
-const { parseHash, formatHash, resolveCamera } = await import(viewerSrc('camera.js'));
+const { parseHash, formatHash, resolveCamera, verticalView } = await import(viewerSrc('camera.js'));
 
 const dir = scratch('data');
 const grids = [];
 const bunny = join(source, 'scenes', 'bunny_1k.obj');
 tool('vox-voxelize', bunny, '-o', join(dir, 'bunny.vgrid'), '--grid', '21', '17', '13', '--fill', '--quiet');
-grids.push({ name: 'bunny filled', grid: 'bunny.vgrid', solidCut: true });
+grids.push({ name: 'bunny filled', grid: 'bunny.vgrid', solidCut: true, spanLonger: false });
 tool('vox-voxelize', join(source, 'scenes', 'scene5_02_spheres.txt'), '-o', join(dir, 'spheres.vgrid'), '--res', '30',
   '--quiet');
-grids.push({ name: 'spheres', grid: 'spheres.vgrid' });
+grids.push({ name: 'spheres', grid: 'spheres.vgrid', spanLonger: true });  // a course camera
 
 for (const g of grids) {
   const grid = join(dir, g.grid);
@@ -34,6 +34,7 @@ for (const g of grids) {
     `${g.name}: bounds exactly vox-info's`,
   );
   check(d.title === g.grid, `${g.name}: title ${d.title}`);
+  check(d.camera.spanLonger === g.spanLonger, `${g.name}: the camera spans the ${g.spanLonger ? 'longer side' : 'height'}`);
   const cells = new Cells(d);
   let same = facts.cells.length === d.occupiedCount;
   for (const c of facts.cells) {
@@ -183,5 +184,17 @@ for (const g of grids) {
   check(cam.eye.join() === '0,0,5' && cam.look.join() === '0,0,1', 'the file camera orbits the grid centre');
   cam = resolveCamera(file, parseHash('#fov=60'), [0, 0, 0]);
   check(cam.fov === 60 && cam.eye.join() === '0,0,5', 'fov alone changes the file camera');
+  // A course camera spans the image's longer side, as vox-trace renders it: on a 2:1 page its 60 degrees are across
+  // the width, so the vertical angle has tan(half) = tan(30) / 2; on a tall page, and for DESIGN.md's cameras, the
+  // angle stays vertical. The hash's fov is vertical (vox-trace's --fov), so it ends the span.
+  const course = { ...file, fov: 60, spanLonger: true };
+  cam = resolveCamera(course, null, [0, 0, 0]);
+  const wide = verticalView(cam, 2);
+  check(Math.abs(Math.tan((wide.fov * Math.PI) / 360) - Math.tan(Math.PI / 6) / 2) < 1e-12, `course camera on a wide page: ${wide.fov} degrees vertical`);
+  check(verticalView(cam, 0.5).fov === 60 && verticalView(cam, 1).fov === 60, 'course camera on a tall or square page: vertical');
+  check(verticalView(resolveCamera(file, null, [0, 0, 0]), 2).fov === 30, "DESIGN.md's cameras stay vertical");
+  check(verticalView({ ...cam, orthographic: true, orthoHeight: 4 }, 2).orthoHeight === 2, 'orthographic course camera: its size across the width');
+  check(resolveCamera(course, parseHash('#eye=1,1,1&look=0,0,0'), [0, 0, 0]).spanLonger, 'eye and look keep the span');
+  check(!resolveCamera(course, parseHash('#fov=50'), [0, 0, 0]).spanLonger, "the hash's fov is vertical");
 }
 finish();

@@ -62,6 +62,7 @@ export function resolveCamera(file, hash, centre) {
     up: file.up.slice(),
     fov: file.fov,
     orthoHeight: file.orthoHeight,
+    spanLonger: Boolean(file.spanLonger),
   };
   const d = len(file.direction) > 0 ? scale(file.direction, 1 / len(file.direction)) : [0, 0, -1];
   const along = dot(sub(centre, file.eye), d);
@@ -74,20 +75,34 @@ export function resolveCamera(file, hash, centre) {
       up: file.up.slice(),
       fov: file.orthographic ? 45 : file.fov,
       orthoHeight: file.orthoHeight,
+      // The file's angle keeps the side it spans (vox-trace: moving the eye keeps the framing's width).
+      spanLonger: !file.orthographic && Boolean(file.spanLonger),
     };
     if (!(len(sub(cam.look, cam.eye)) > 0)) throw new Error('hash: eye and look must differ');
   }
   if (hash && hash.up) cam.up = hash.up.slice();
+  // The hash's fov and ortho are vertical, as vox-trace's --fov is.
   if (hash && hash.fov !== undefined) {
     cam.orthographic = false;
     cam.fov = hash.fov;
+    cam.spanLonger = false;
   } else if (hash && hash.ortho !== undefined) {
     cam.orthographic = true;
     cam.orthoHeight = hash.ortho;
+    cam.spanLonger = false;
   }
   const dir = sub(cam.look, cam.eye);
   const u = cam.up;
   const c = [dir[1] * u[2] - dir[2] * u[1], dir[2] * u[0] - dir[0] * u[2], dir[0] * u[1] - dir[1] * u[0]];
   if (!(len(c) > 0)) throw new Error('camera: up must not be parallel to the view direction');
   return cam;
+}
+
+// The vertical field of view (degrees) and image height of a resolved camera on an image of width / height
+// `aspect`: a camera spanning the longer side spreads its angle or size across the width of a wide image, as
+// vox-trace renders it (tan of the half angle, or the size, scaled by height / width).
+export function verticalView(cam, aspect) {
+  if (!cam.spanLonger || !(aspect > 1)) return { fov: cam.fov, orthoHeight: cam.orthoHeight };
+  const half = Math.atan(Math.tan((cam.fov * Math.PI) / 360) / aspect);
+  return { fov: (half * 360) / Math.PI, orthoHeight: cam.orthoHeight / aspect };
 }

@@ -85,6 +85,7 @@ export function decodeViewerData(bytes) {
     colorMode: ['count', 'material', 'none'][u32(76)] ?? 'none',
     camera: {
       orthographic: (flags & 64) !== 0,
+      spanLonger: (flags & 128) !== 0,
       eye: vec(80),
       direction: vec(104),
       up: vec(128),

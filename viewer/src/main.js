@@ -5,7 +5,7 @@ import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 
 import { decodeViewerData, layoutFromElements } from './data.js';
-import { formatHash, parseHash, resolveCamera } from './camera.js';
+import { formatHash, parseHash, resolveCamera, verticalView } from './camera.js';
 import { Cells } from './cells.js';
 import { cubes, surfaceMaterial } from './surface.js';
 import { blockFactor, blockSurface } from './lod.js';
@@ -158,11 +158,12 @@ async function start() {
   function applyCamera(cam) {
     view = cam;
     const aspect = Math.max(1, canvas.clientWidth) / Math.max(1, canvas.clientHeight);
+    const vertical = verticalView(cam, aspect);
     if (cam.orthographic) {
-      const h = 0.5 * cam.orthoHeight;
+      const h = 0.5 * vertical.orthoHeight;
       camera = new THREE.OrthographicCamera(-h * aspect, h * aspect, h, -h, 0, 1);
     } else {
-      camera = new THREE.PerspectiveCamera(cam.fov, aspect, 0.1, 1);
+      camera = new THREE.PerspectiveCamera(vertical.fov, aspect, 0.1, 1);
     }
     camera.up.set(...cam.up);
     camera.position.set(...rel(cam.eye));

@@ -294,7 +294,8 @@ std::string encodeViewerData(const Grid& grid, const Scene& scene, const ViewerP
   w.bytes.append("VOXVIEW", 8);  // with its terminating zero
   w.put(kViewerDataVersion);
   const uint32_t flags = (colors ? 1u : 0u) | (wide ? 2u : 0u) | widthCode(countWidth) << 2 |
-                         widthCode(paletteWidth) << 4 | (camera.kind == CameraKind::Orthographic ? 64u : 0u);
+                         widthCode(paletteWidth) << 4 | (camera.kind == CameraKind::Orthographic ? 64u : 0u) |
+                         (camera.span == CameraSpan::LongerSide ? 128u : 0u);
   w.put(flags);
   for (int a = 0; a < 3; ++a) w.put(grid.bounds.lo[a]);
   for (int a = 0; a < 3; ++a) w.put(grid.bounds.hi[a]);

@@ -37,6 +37,8 @@ check version 0 "$V" --version
 check sphere 0 "$V" "$SRC/scenes/scene5_01_sphere.txt" -o "$T/s.vgrid" --grid 15 15 15 --quiet
 check info 0 "$I" "$T/s.vgrid"
 grep -q "occupied_cells:" "$T/out" || { echo "FAIL info output"; fails=$((fails + 1)); }
+# A course camera spans the image's longer side (how vox-trace frames a non-square image); a mesh has no camera.
+grep -q "^camera: orthographic (spans the longer side)$" "$T/out" || { echo "FAIL info camera span"; fails=$((fails + 1)); }
 check info_json 0 "$I" "$T/s.vgrid" --json --cells --primitives
 python3 - "$T/out" <<'PY' || fails=$((fails + 1))
 import json, sys

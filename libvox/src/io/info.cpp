@@ -108,7 +108,11 @@ void plain(std::ostream& out, const InfoSource& in) {
   out << "\n";
   out << "lights: " << sc.lights.size() << "\n";
   out << "camera: "
-      << (sc.camera ? (sc.camera->kind == CameraKind::Perspective ? "perspective" : "orthographic") : "none") << "\n";
+      << (sc.camera ? (sc.camera->kind == CameraKind::Perspective ? "perspective" : "orthographic") : "none");
+  // Which side its angle or size spans decides the framing of a non-square image (docs/trace.md).
+  if (sc.camera)
+    out << (sc.camera->span == CameraSpan::LongerSide ? " (spans the longer side)" : " (spans the height)");
+  out << "\n";
   out << "occupied_cells: " << t.occupied << "\n";
   out << "solid_cells: " << t.solidCells << "\n";
   out << "references: " << t.references << "\n";

@@ -36,7 +36,8 @@ GridFile readGridFile(const std::string& path);
 uint64_t gridChecksum(const char* payload, size_t size);
 
 // The same on bytes in memory (fuzzing, tests). `name` is used in error messages. `version` 2 writes the previous
-// layout, for tests that old files still read.
+// layout, for tests that old files still read. The grid must be well-formed (every cell's offsets inside primIds,
+// as voxelizeScene and decodeGridFile make it): version 3's encoder reads each cell's ids.
 std::string encodeGridFile(const Scene& scene, const Grid& grid, uint32_t version = kGridFileVersion);
 GridFile decodeGridFile(const std::string& bytes, const std::string& name);
 

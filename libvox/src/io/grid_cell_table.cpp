@@ -10,12 +10,12 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <bit>
 #include <cstring>
 #include <limits>
 #include <utility>
 
 #include "vox/core/huge_pages.h"
+#include "vox/core/varint.h"
 
 namespace vox {
 namespace {
@@ -24,17 +24,6 @@ constexpr uint64_t kChunkCells = uint64_t(1) << 15;
 
 uint64_t zigzag(int64_t v) { return (uint64_t(v) << 1) ^ uint64_t(v >> 63); }
 int64_t unzigzag(uint64_t v) { return int64_t(v >> 1) ^ -int64_t(v & 1); }
-
-size_t varintSize(uint64_t v) { return (size_t(std::bit_width(v | 1)) + 6) / 7; }
-
-char* putVarint(char* p, uint64_t v) {
-  while (v >= 0x80) {
-    *p++ = char(uint8_t(v) | 0x80);
-    v >>= 7;
-  }
-  *p++ = char(v);
-  return p;
-}
 
 // Calls emit(value) for every varint of cells [begin, end), in file order.
 template <typename Emit>
@@ -70,7 +59,7 @@ EncodedCellTable encodeCellTable(const Grid& grid) {
   reserveOnHugePages(table.bytes, offset[chunks]);
   table.bytes.resize(offset[chunks]);
   tbb::parallel_for(size_t(0), chunks, [&](size_t i) {
-    char* p = table.bytes.data() + offset[i];
+    uint8_t* p = reinterpret_cast<uint8_t*>(table.bytes.data()) + offset[i];
     forEachValue(grid, cells(i).first, cells(i).second, [&](uint64_t v) { p = putVarint(p, v); });
   });
   return table;
@@ -99,16 +88,11 @@ class TableDecoder {
     fail<InputError>(name_, ": cell table at byte ", offset_ + size_t(p_ - base_), ": ", what);
   }
   uint64_t varint() {
-    if (p_ < end_ && *p_ < 0x80) return *p_++;  // most values: one byte
     uint64_t v = 0;
-    for (int shift = 0; shift < 64; shift += 7) {
-      if (p_ == end_) bad("truncated number");
-      const uint8_t b = *p_++;
-      if ((shift == 63 && b > 1) || (shift > 0 && b == 0)) bad("number too large or not in its shortest form");
-      v |= uint64_t(b & 0x7f) << shift;
-      if (b < 0x80) return v;
-    }
-    bad("number too large");
+    const VarintStatus status = getVarint(p_, end_, v);
+    if (status == VarintStatus::Truncated) bad("truncated number");
+    if (status == VarintStatus::Malformed) bad("number too large or not in its shortest form");
+    return v;
   }
   bool atEnd() const { return p_ == end_; }
 

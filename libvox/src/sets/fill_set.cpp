@@ -7,22 +7,20 @@
 #include <span>
 #include <vector>
 
+#include "vox/core/error.h"
+#include "vox/core/varint.h"
+
 namespace vox {
 
 namespace {
 
-// LEB128: seven bits a byte, low first, the top bit saying another byte follows. Only our own bytes are read.
-void appendVarint(std::vector<uint8_t>& bytes, uint64_t v) {
-  for (; v >= 0x80; v >>= 7) bytes.push_back(uint8_t(v & 0x7f) | 0x80);
-  bytes.push_back(uint8_t(v));
-}
+// The varint at bytes[pos] (vox/core/varint.h); pos moves past it. Only our own bytes are read.
 uint64_t readVarint(const std::vector<uint8_t>& bytes, size_t& pos) {
+  const uint8_t* p = bytes.data() + pos;
   uint64_t v = 0;
-  for (int shift = 0;; shift += 7) {
-    const uint8_t b = bytes[pos++];
-    v |= uint64_t(b & 0x7f) << shift;
-    if (!(b & 0x80)) return v;
-  }
+  VOX_CHECK(getVarint(p, bytes.data() + bytes.size(), v) == VarintStatus::Ok);
+  pos = size_t(p - bytes.data());
+  return v;
 }
 
 // The sorted keys of one brick, delta-coded: a run of cells along x costs a byte a cell, a step to the next row two

@@ -1,8 +1,12 @@
-// Reading meshes: vox::loadScene (our exact double reader, issue 26's "200 MB/s per thread") against OpenMesh's
-// OBJ and PLY readers (floats) on the same files, runs alternating, the best of --runs each; MB/s and the ratio.
-//   build/bench/bench_read [--runs N] [FILE...]     (default: the SheenCloth OBJ, the 69k bunny OBJ and PLY)
+// Reading meshes: vox::loadScene (our exact double reader, issue 26's "200 MB/s per thread") on one thread and on
+// all, against OpenMesh's OBJ and PLY readers (floats, one thread) on the same files; runs alternating, the best of
+// --runs each; MB/s and the ratio of OpenMesh's time to ours on all threads.
+//   build/bench/bench_read [--runs N] [--ours-only] [FILE...]   (default: the SheenCloth OBJ, the 69k bunny OBJ, PLY)
+// --ours-only leaves OpenMesh out, for a profile of our reader alone (perf record).
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+#include <tbb/global_control.h>
+#include <tbb/info.h>
 
 #include <algorithm>
 #include <chrono>
@@ -20,7 +24,8 @@ using OpenMeshTriangles = OpenMesh::TriMesh_ArrayKernelT<>;
 
 double seconds(Clock::time_point since) { return std::chrono::duration<double>(Clock::now() - since).count(); }
 
-double timeOurs(const std::string& path, size_t& triangles) {
+double timeOurs(const std::string& path, size_t& triangles, int threads) {
+  const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
   const auto start = Clock::now();
   const vox::Scene scene = vox::loadScene(path);
   const double s = seconds(start);
@@ -41,10 +46,13 @@ double timeOpenMesh(const std::string& path, size_t& faces) {
 
 int main(int argc, char** argv) {
   int runs = 7;
+  bool oursOnly = false;
   std::vector<std::string> files;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--runs" && i + 1 < argc)
+    if (a == "--ours-only")
+      oursOnly = true;
+    else if (a == "--runs" && i + 1 < argc)
       runs = std::max(1, std::atoi(argv[++i]));
     else
       files.push_back(a);
@@ -54,20 +62,22 @@ int main(int argc, char** argv) {
     files = {seed + "/meshes/derived/sheencloth_115k.obj", seed + "/meshes/derived/stanford_bunny_69k.obj",
              seed + "/meshes/bun_zipper.ply"};
   }
-  std::printf("%-26s %9s %10s %10s %10s %10s %8s\n", "file", "MB", "ours_ms", "ours_MB/s", "omesh_ms", "omesh_MB/s",
-              "ratio");
+  const int threads = tbb::info::default_concurrency();
+  std::printf("%-26s %7s %9s %9s %9s %9s %9s %10s %7s  (%d threads)\n", "file", "MB", "1t_ms", "1t_MB/s", "all_ms",
+              "all_MB/s", "omesh_ms", "omesh_MB/s", "ratio", threads);
   for (const std::string& f : files) {
     const double mb = double(std::filesystem::file_size(f)) / 1e6;
-    double ours = 1e30, theirs = 1e30;
+    double one = 1e30, all = 1e30, theirs = 1e30;
     size_t ourTriangles = 0, theirFaces = 0;
-    for (int r = 0; r < runs; ++r) {  // alternating, so that a noisy moment hits both
-      ours = std::min(ours, timeOurs(f, ourTriangles));
-      const double t = timeOpenMesh(f, theirFaces);
+    for (int r = 0; r < runs; ++r) {  // alternating, so that a noisy moment hits all three
+      one = std::min(one, timeOurs(f, ourTriangles, 1));
+      all = std::min(all, timeOurs(f, ourTriangles, threads));
+      const double t = oursOnly ? -1 : timeOpenMesh(f, theirFaces);
       if (t >= 0) theirs = std::min(theirs, t);
     }
-    std::printf("%-26s %9.2f %10.2f %10.0f %10.2f %10.0f %8.2f   (%zu triangles; OpenMesh %zu faces)\n",
-                std::filesystem::path(f).filename().c_str(), mb, ours * 1e3, mb / ours, theirs * 1e3, mb / theirs,
-                theirs / ours, ourTriangles, theirFaces);
+    std::printf("%-26s %7.2f %9.2f %9.0f %9.2f %9.0f %9.2f %10.0f %7.2f  (%zu triangles; OpenMesh %zu faces)\n",
+                std::filesystem::path(f).filename().c_str(), mb, one * 1e3, mb / one, all * 1e3, mb / all, theirs * 1e3,
+                mb / theirs, theirs / all, ourTriangles, theirFaces);
   }
   return 0;
 }

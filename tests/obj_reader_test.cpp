@@ -44,8 +44,12 @@ std::string inputError(F&& f) {
   return "";
 }
 
+// The error of reading `text` in one piece, which must also be the error of reading it a line per chunk
+// (obj_chunks.h; obj_chunks_test.cpp compares every field of the readings).
 std::string objError(const std::string& text) {
-  return inputError([&] { parseObj(text, "a.obj"); });
+  const std::string whole = inputError([&] { parseObj(text, "a.obj"); });
+  EXPECT_EQ(inputError([&] { parseObj(text, "a.obj", 1); }), whole) << "read a line per chunk";
+  return whole;
 }
 
 uint64_t bits(double x) { return std::bit_cast<uint64_t>(x); }

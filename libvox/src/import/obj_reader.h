@@ -1,7 +1,8 @@
-// The one Wavefront OBJ / MTL reader of libvox, shared by the OBJ importer (import_obj.cpp) and the course
-// format's TriangleMesh (import_course.cpp). Numbers are read with std::from_chars to the nearest double (never
-// through float); NaN, infinities, out-of-range and malformed numbers are refused. Every error is an InputError
-// naming "file:line: ...", the line being the first physical line of a statement.
+// The one Wavefront OBJ / MTL reader of libvox (obj_reader.cpp, obj_chunks.cpp, mtl_reader.cpp, obj_text.cpp),
+// shared by the OBJ importer (import_obj.cpp) and the course format's TriangleMesh (import_course.cpp). Numbers are
+// read with std::from_chars to the nearest double (never through float); NaN, infinities, out-of-range and malformed
+// numbers are refused. Every error is an InputError naming "file:line: ...", the line being the first physical line of
+// a statement.
 //
 // OBJ statements read: `v x y z [more numbers]`, `f a b c ...` (any polygon size, fan-triangulated in linear time;
 // forms a, a/t, a//n, a/t/n use the vertex index a; negative indices count back from the vertices read so far;
@@ -64,8 +65,12 @@ std::string quotedWord(std::string_view word);
 // budget). Throws InputError naming `path` when it cannot be read or is larger than `maxBytes`.
 std::string readTextFile(const std::string& path, const char* what, size_t maxBytes);
 
-// Parses OBJ text; `path` only names the file in messages. Throws InputError "path:line: ...".
-ObjData parseObj(std::string_view text, const std::string& path);
+// Texts of at least twice this many bytes are read in chunks of about this size, on all threads (obj_chunks.h).
+constexpr size_t kObjChunkBytes = size_t{1} << 19;
+
+// Parses OBJ text; `path` only names the file in messages. Throws InputError "path:line: ..." for the file's first
+// error. The result and the error do not depend on chunkBytes (tests read texts in chunks of single lines).
+ObjData parseObj(std::string_view text, const std::string& path, size_t chunkBytes = kObjChunkBytes);
 
 // A `map_Kd` of material `material` (an index into parseMtl's result): the file as written, its line, `-clamp on`.
 struct MtlDiffuseMap {

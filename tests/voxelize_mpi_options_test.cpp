@@ -2,6 +2,8 @@
 // combinations CLI11 cannot refuse, and the voxelizer's options taken from it. No mpirun needed.
 #include "voxelize-mpi/options.h"
 
+#include "common/cli_app.h"
+
 #include <gtest/gtest.h>
 
 #include <vector>

@@ -1,15 +1,15 @@
-// Command-line plumbing shared by the tools' mains: CLI11 parsing with STYLE.md exit codes, --threads, --version.
+// Command-line plumbing shared by the tools: the options every tool takes and --threads. CLI11 itself is in
+// cli_app.h, included only by the files that build or parse a CLI::App: its header takes some ten seconds to compile
+// in each file that includes it.
 #pragma once
 
 #include <tbb/global_control.h>
 
-#include <CLI/CLI.hpp>
-#include <cstdio>
 #include <memory>
-#include <optional>
-#include <string>
 
-#include "vox/core/tool.h"
+namespace CLI {
+class App;
+}
 
 namespace vox::cli {
 
@@ -18,28 +18,6 @@ struct CommonOptions {
   bool quiet = false;
   unsigned threads = 0;  // 0: all cores
 };
-
-inline void addCommonOptions(CLI::App& app, CommonOptions& common) {
-  app.set_version_flag("--version", std::string("libvox ") + versionString());
-  app.add_flag("-q,--quiet", common.quiet, "No progress bar or warnings on stderr");
-  app.add_option("--threads", common.threads, "Worker threads (default: all cores)")->check(CLI::Range(1u, 4096u));
-}
-
-// Parses argv; returns an exit code when the tool should stop now (help, version: 0; bad usage: 1).
-inline std::optional<int> parse(CLI::App& app, int argc, char** argv) {
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForVersion& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    // One line, like every other error; --help is named in it.
-    std::fprintf(stderr, "%s: error: %s (see --help)\n", app.get_name().c_str(), e.what());
-    return kExitUsage;
-  }
-  return std::nullopt;
-}
 
 // Limits TBB to the requested thread count for the lifetime of the returned object.
 inline std::unique_ptr<tbb::global_control> limitThreads(unsigned threads) {

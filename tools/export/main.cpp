@@ -79,11 +79,6 @@ int run(const Options& opt) {
 
 int main(int argc, char** argv) {
   Options opt;
-  CLI::App app{
-      "Write the voxels of a grid file (occupied and solid cells) as a mesh for MeshLab, Blender and "
-      "other mesh tools; the format follows the output's extension.",
-      "vox-export"};
-  export_tool::addOptions(app, opt);
-  if (auto code = cli::parse(app, argc, argv)) return *code;
+  if (auto code = export_tool::parseCommandLine(argc, argv, opt)) return *code;
   return runTool("vox-export", [&] { return run(opt); });
 }

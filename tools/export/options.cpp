@@ -1,5 +1,7 @@
 #include "options.h"
 
+#include "../common/cli_app.h"
+
 namespace vox::export_tool {
 
 void addOptions(CLI::App& app, Options& opt) {
@@ -27,6 +29,15 @@ void addOptions(CLI::App& app, Options& opt) {
                "and their ratio, times");
   cli::addCommonOptions(app, opt.common);
   app.footer("Exit codes: 0 ok, 1 usage (including an unknown output extension), 2 bad input, 3 cannot write.");
+}
+
+std::optional<int> parseCommandLine(int argc, char** argv, Options& opt) {
+  CLI::App app{
+      "Write the voxels of a grid file (occupied and solid cells) as a mesh for MeshLab, Blender and "
+      "other mesh tools; the format follows the output's extension.",
+      "vox-export"};
+  addOptions(app, opt);
+  return cli::parse(app, argc, argv);
 }
 
 }  // namespace vox::export_tool

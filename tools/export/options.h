@@ -1,7 +1,7 @@
 // vox-export's command line: the options parsed into a struct.
 #pragma once
 
-#include <CLI/CLI.hpp>
+#include <optional>
 #include <string>
 
 #include "../common/cli.h"
@@ -20,5 +20,8 @@ struct Options {
 
 // Adds the tool's positional argument, options and flags to `app`, bound to `opt`, with the help's footer.
 void addOptions(CLI::App& app, Options& opt);
+
+// Parses argv into opt; returns the exit code when the tool should stop now (help, version: 0; bad usage: 1).
+std::optional<int> parseCommandLine(int argc, char** argv, Options& opt);
 
 }  // namespace vox::export_tool

@@ -2,7 +2,7 @@
 #include <cstdio>
 #include <iostream>
 
-#include "../common/cli.h"
+#include "../common/cli_app.h"
 #include "vox/io/grid_file.h"
 #include "vox/io/grid_set.h"
 #include "vox/io/info.h"

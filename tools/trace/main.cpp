@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "options.h"
+#include "vox/core/tool.h"
 #include "vox/core/error.h"
 #include "vox/core/progress.h"
 #include "vox/io/grid_set.h"
@@ -58,8 +59,6 @@ int run(const Options& opt) {
 
 int main(int argc, char** argv) {
   Options opt;
-  CLI::App app{"Render an image from a grid file (.vgrid) by marching rays through the grid.", "vox-trace"};
-  trace_tool::addOptions(app, opt);
-  if (auto code = cli::parse(app, argc, argv)) return *code;
+  if (auto code = trace_tool::parseCommandLine(argc, argv, opt)) return *code;
   return runTool("vox-trace", [&] { return run(opt); });
 }

@@ -1,5 +1,7 @@
 #include "options.h"
 
+#include "../common/cli_app.h"
+
 #include <cmath>
 #include <cstdlib>
 
@@ -113,6 +115,12 @@ Camera resolveCamera(const Options& opt, const GridFile& file) {
     cam.span = CameraSpan::Height;  // --fov is vertical (DESIGN.md), whatever the scene's camera spans
   }
   return cam;
+}
+
+std::optional<int> parseCommandLine(int argc, char** argv, Options& opt) {
+  CLI::App app{"Render an image from a grid file (.vgrid) by marching rays through the grid.", "vox-trace"};
+  addOptions(app, opt);
+  return cli::parse(app, argc, argv);
 }
 
 }  // namespace vox::trace_tool

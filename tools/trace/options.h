@@ -1,8 +1,8 @@
 // vox-trace's command line: the options parsed into a struct, the renderer's options and the camera taken from it.
 #pragma once
 
-#include <CLI/CLI.hpp>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,6 +31,9 @@ struct Options {
 
 // Adds the tool's positional argument, options and flags to `app`, bound to `opt`, with the help's footer.
 void addOptions(CLI::App& app, Options& opt);
+
+// Parses argv into opt; returns the exit code when the tool should stop now (help, version: 0; bad usage: 1).
+std::optional<int> parseCommandLine(int argc, char** argv, Options& opt);
 
 // The renderer's options from everything the command line alone decides (all but the camera), checked before the
 // grid is read: a bad --size, --samples, --filter or output extension is a UsageError.

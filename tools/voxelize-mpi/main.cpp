@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "options.h"
+#include "vox/core/tool.h"
 #include "runs.h"
 
 namespace {
@@ -24,29 +25,6 @@ unsigned defaultThreads() {
   return std::max(1u, cores / unsigned(std::max(1, localRanks)));
 }
 
-// Parses the command line on every rank; only rank 0 prints help, versions and usage errors, the others parse
-// silently to the same result. Returns the exit code when the tool should stop now.
-std::optional<int> parseOnEveryRank(CLI::App& app, const vox::mpi::Options& opt, int rank, int argc, char** argv) {
-  std::optional<int> early;
-  if (rank == 0) {
-    early = vox::cli::parse(app, argc, argv);
-  } else {
-    try {
-      app.parse(argc, argv);
-    } catch (const CLI::Success&) {
-      early = 0;
-    } catch (const CLI::ParseError&) {
-      early = vox::kExitUsage;
-    }
-  }
-  if (early) return early;
-  if (const std::string error = vox::mpi::modeError(opt); !error.empty()) {
-    if (rank == 0) std::fprintf(stderr, "vox-voxelize-mpi: error: %s\n", error.c_str());
-    return vox::kExitUsage;
-  }
-  return std::nullopt;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -55,12 +33,7 @@ int main(int argc, char** argv) {
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   vox::mpi::Options opt;
-  CLI::App app{
-      "Voxelize over Open MPI ranks: one scene into a grid set (--bricks), or a batch of scenes into one grid "
-      "each (--batch). Run as mpirun -n K vox-voxelize-mpi ...",
-      "vox-voxelize-mpi"};
-  vox::mpi::addOptions(app, opt);
-  const std::optional<int> early = parseOnEveryRank(app, opt, rank, argc, argv);
+  const std::optional<int> early = vox::mpi::parseOnEveryRank(rank, argc, argv, opt);
   int code = early.value_or(0);
   if (!early) {
     auto threads = vox::cli::limitThreads(opt.common.threads ? opt.common.threads : defaultThreads());

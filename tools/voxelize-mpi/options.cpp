@@ -1,5 +1,7 @@
 #include "options.h"
 
+#include "../common/cli_app.h"
+
 #include "../common/grid_flags.h"
 
 namespace vox::mpi {
@@ -37,6 +39,34 @@ std::string modeError(const Options& opt) {
 
 VoxelizeOptions voxelizeOptions(const Options& opt) {
   return cli::voxelizeOptionsFromFlags(opt.method, opt.grid, opt.resolution, opt.bounds);
+}
+
+// Parses the command line on every rank; only rank 0 prints help, versions and usage errors, the others parse
+// silently to the same result. Returns the exit code when the tool should stop now.
+std::optional<int> parseOnEveryRank(int rank, int argc, char** argv, Options& opt) {
+  CLI::App app{
+      "Voxelize over Open MPI ranks: one scene into a grid set (--bricks), or a batch of scenes into one grid "
+      "each (--batch). Run as mpirun -n K vox-voxelize-mpi ...",
+      "vox-voxelize-mpi"};
+  addOptions(app, opt);
+  std::optional<int> early;
+  if (rank == 0) {
+    early = cli::parse(app, argc, argv);
+  } else {
+    try {
+      app.parse(argc, argv);
+    } catch (const CLI::Success&) {
+      early = 0;
+    } catch (const CLI::ParseError&) {
+      early = kExitUsage;
+    }
+  }
+  if (early) return early;
+  if (const std::string error = modeError(opt); !error.empty()) {
+    if (rank == 0) std::fprintf(stderr, "vox-voxelize-mpi: error: %s\n", error.c_str());
+    return kExitUsage;
+  }
+  return std::nullopt;
 }
 
 }  // namespace vox::mpi

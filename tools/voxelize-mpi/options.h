@@ -2,8 +2,8 @@
 // voxelizer's options taken from them. No MPI here (tests/voxelize_mpi_options_test.cpp).
 #pragma once
 
-#include <CLI/CLI.hpp>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,6 +28,10 @@ struct Options {
 
 // Adds the tool's positional argument, options and flags to `app`, bound to `opt`, with the help's footer.
 void addOptions(CLI::App& app, Options& opt);
+
+// Parses the command line on every rank; only rank 0 prints help, versions and usage errors, the others parse
+// silently to the same result. Returns the exit code when the tool should stop now.
+std::optional<int> parseOnEveryRank(int rank, int argc, char** argv, Options& opt);
 
 // What is wrong with a command line CLI11 accepted ("" when nothing): neither or both of SCENE and --batch, or SCENE
 // without --bricks. Printed by rank 0 as "vox-voxelize-mpi: error: ..." with exit code 1.

@@ -85,9 +85,6 @@ int run(const Options& opt) {
 
 int main(int argc, char** argv) {
   Options opt;
-  CLI::App app{"Voxelize a scene (.txt course format, .obj, .gltf, .glb, .ply) into a sparse grid file (.vgrid).",
-               "vox-voxelize"};
-  voxelize_tool::addOptions(app, opt);
-  if (auto code = cli::parse(app, argc, argv)) return *code;
+  if (auto code = voxelize_tool::parseCommandLine(argc, argv, opt)) return *code;
   return runTool("vox-voxelize", [&] { return run(opt); });
 }

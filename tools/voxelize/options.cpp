@@ -1,5 +1,7 @@
 #include "options.h"
 
+#include "../common/cli_app.h"
+
 #include "../common/grid_flags.h"
 
 namespace vox::voxelize_tool {
@@ -34,6 +36,13 @@ void addOptions(CLI::App& app, Options& opt) {
 
 VoxelizeOptions voxelizeOptions(const Options& opt) {
   return cli::voxelizeOptionsFromFlags(opt.method, opt.grid, opt.resolution, opt.bounds);
+}
+
+std::optional<int> parseCommandLine(int argc, char** argv, Options& opt) {
+  CLI::App app{"Voxelize a scene (.txt course format, .obj, .gltf, .glb, .ply) into a sparse grid file (.vgrid).",
+               "vox-voxelize"};
+  addOptions(app, opt);
+  return cli::parse(app, argc, argv);
 }
 
 }  // namespace vox::voxelize_tool

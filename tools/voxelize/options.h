@@ -1,8 +1,8 @@
 // vox-voxelize's command line: the options parsed into a struct and the voxelizer's options taken from it.
 #pragma once
 
-#include <CLI/CLI.hpp>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,6 +26,9 @@ struct Options {
 
 // Adds the tool's positional argument, options and flags to `app`, bound to `opt`, with the help's footer.
 void addOptions(CLI::App& app, Options& opt);
+
+// Parses argv into opt; returns the exit code when the tool should stop now (help, version: 0; bad usage: 1).
+std::optional<int> parseCommandLine(int argc, char** argv, Options& opt);
 
 // The voxelizer's options: method, --grid or --res, --bounds, and the memory budget. Throws InputError for an
 // unknown method (CLI11 has refused it before).

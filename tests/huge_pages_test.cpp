@@ -1,5 +1,6 @@
 // The huge-page requests change speed only: arrays keep their contents through every reservation and growth step,
-// and a mesh large enough to cross many growth steps reads back bit for bit (issue 26).
+// a mesh large enough to cross many growth steps reads back bit for bit, and HugeBuffer holds every byte of its size
+// on whole 2 MiB pages (issue 26).
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -10,7 +11,11 @@
 #include <vector>
 
 #include "import/obj_reader.h"
+#include "vox/core/error.h"
+#include "vox/core/huge_buffer.h"
 #include "vox/core/huge_pages.h"
+#include "vox/io/input_file.h"
+#include "test_util.h"
 
 namespace vox {
 namespace {
@@ -79,6 +84,50 @@ TEST(HugePages, LargeObjReadsBackBitForBit) {
     ASSERT_EQ(obj.triangles[i][1], i + 1);
     ASSERT_EQ(obj.triangles[i][2], kVertices - 1);  // -1: the last vertex read, all are read before the faces
   }
+}
+
+TEST(HugeBuffer, HoldsEveryByteOfItsSizeOnWholeHugePages) {
+  constexpr size_t kHuge = size_t{2} << 20;
+  for (size_t size : {size_t{0}, size_t{1}, kHuge - 1, kHuge, kHuge + 1, 5 * kHuge + 12345}) {
+    HugeBuffer b(size);
+    ASSERT_EQ(b.size(), size);
+    ASSERT_EQ(b.view().size(), size);
+    if (size == 0) continue;
+    if (size >= kHuge) {
+      EXPECT_EQ(reinterpret_cast<uintptr_t>(b.data()) % kHuge, 0u) << size;
+    }
+    for (size_t i = 0; i < size; ++i) b.data()[i] = char(i * 7);  // every byte writable (ASan checks the range)
+    HugeBuffer moved(std::move(b));
+    EXPECT_EQ(b.size(), 0u);
+    EXPECT_EQ(b.data(), nullptr);
+    ASSERT_EQ(moved.size(), size);
+    EXPECT_EQ(moved.data()[size - 1], char((size - 1) * 7));
+    HugeBuffer assigned(kHuge + 3);
+    assigned = std::move(moved);  // the old mapping released, the new one kept
+    EXPECT_EQ(assigned.data()[size / 2], char((size / 2) * 7));
+    assigned.shrink(size / 2);
+    EXPECT_EQ(assigned.size(), size / 2);
+    assigned.shrink(size);  // never grows
+    EXPECT_EQ(assigned.size(), size / 2);
+  }
+}
+
+TEST(HugeBuffer, ReadInputBytesReadsWhatReadInputFileReads) {
+  testing::ScratchDir dir("hugebuf");
+  std::mt19937 random(26);
+  for (size_t size : {size_t{0}, size_t{100}, (size_t{2} << 20) + 77, size_t{9} << 20}) {
+    std::string bytes(size, '\0');
+    for (char& c : bytes) c = char(random());
+    const std::string path = dir.file("f" + std::to_string(size));
+    std::FILE* f = std::fopen(path.c_str(), "wb");
+    ASSERT_NE(f, nullptr);
+    ASSERT_EQ(std::fwrite(bytes.data(), 1, bytes.size(), f), bytes.size());
+    std::fclose(f);
+    EXPECT_EQ(readInputBytes(path, "test file").view(), bytes);
+    EXPECT_EQ(readInputFile(path, "test file"), bytes);
+  }
+  EXPECT_THROW(readInputBytes(dir.file("none"), "test file"), InputError);
+  EXPECT_THROW(readInputBytes("/dev/zero", "test file"), InputError);
 }
 
 }  // namespace

@@ -215,7 +215,7 @@ TEST(ObjChunks, TheSeedMeshesReadTheSameInOneAndInManyChunks) {
   for (const char* name : {"meshes/derived/sheencloth_115k.obj", "meshes/derived/stanford_bunny_69k.obj",
                            "meshes/teapot.obj", "meshes/spot.obj"}) {
     const std::string path = std::string(VOX_SEED_DIR) + "/" + name;
-    const std::string text = readTextFile(path, "OBJ file", kMaxObjFileBytes);
+    const std::string text(readTextFile(path, "OBJ file", kMaxObjFileBytes).view());
     const Reading many = readIn(text, 4096);
     ASSERT_EQ(many.error, "");
     EXPECT_GT(cutObjText(text, 4096).size(), 10u);

@@ -565,7 +565,7 @@ class CourseParser {
     if (it == meshes_.end()) {
       std::error_code ec;
       if (!std::filesystem::is_regular_file(objPath, ec)) failAt(name, "cannot open mesh file '", objPath, "'");
-      it = meshes_.emplace(key, parseObj(readTextFile(objPath, "mesh file", kMaxObjFileBytes), objPath)).first;
+      it = meshes_.emplace(key, parseObj(readTextFile(objPath, "mesh file", kMaxObjFileBytes).view(), objPath)).first;
       for (const std::string& w : it->second.warnings) warn(w);
     }
     const ObjData& mesh = it->second;

@@ -91,10 +91,10 @@ std::map<std::string, uint32_t> loadLibraries(const std::string& objPath, const 
     if (!file || !read.insert(*file).second) continue;
     // Messages name the library as the OBJ file names it, beside the OBJ file.
     const std::string shown = (fs::path(objPath).parent_path() / lib.name).string();
-    const std::string text = readTextFile(file->string(), "material library", kMaxMtlFileBytes);
+    const HugeBuffer text = readTextFile(file->string(), "material library", kMaxMtlFileBytes);
     std::vector<MtlDiffuseMap> maps;
     const size_t base = scene.materials.size();
-    for (Material& m : parseMtl(text, shown, scene.warnings, &maps)) {
+    for (Material& m : parseMtl(text.view(), shown, scene.warnings, &maps)) {
       byName[m.name] = static_cast<uint32_t>(scene.materials.size());
       scene.materials.push_back(std::move(m));
     }
@@ -111,7 +111,7 @@ std::map<std::string, uint32_t> loadLibraries(const std::string& objPath, const 
 }  // namespace
 
 Scene importObj(const std::string& path) {
-  const ObjData obj = parseObj(readTextFile(path, "OBJ file", kMaxObjFileBytes), path);
+  const ObjData obj = parseObj(readTextFile(path, "OBJ file", kMaxObjFileBytes).view(), path);
   Scene scene;
   scene.warnings = obj.warnings;
   const std::map<std::string, uint32_t> byName = loadLibraries(path, obj, scene);

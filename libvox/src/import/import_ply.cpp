@@ -117,13 +117,13 @@ bool parseProperty(const std::vector<std::string>& w, PlyElement& e) {
   return true;
 }
 
-PlyHeader parseHeader(const std::string& data, const std::string& path) {
+PlyHeader parseHeader(std::string_view data, const std::string& path) {
   PlyHeader h;
   size_t pos = 0;
   for (;;) {
     const size_t eol = data.find('\n', pos);
     if (eol == std::string::npos) fail<InputError>(path, ": PLY header has no end_header line");
-    std::string line = data.substr(pos, eol - pos);
+    std::string line(data.substr(pos, eol - pos));
     pos = eol + 1;
     const long long lineNumber = ++h.lines;
     if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -210,7 +210,7 @@ struct PlyMesh {
 // ASCII body: whitespace-separated tokens, each checked against its declared type.
 class AsciiCursor {
  public:
-  AsciiCursor(const std::string& data, const PlyHeader& h, const std::string& path)
+  AsciiCursor(std::string_view data, const PlyHeader& h, const std::string& path)
       : data_(data), pos_(h.bodyStart), line_(h.lines + 1), path_(path) {}
 
   void at(const PlyElement& e, long long i) {
@@ -253,7 +253,7 @@ class AsciiCursor {
     const size_t start = pos_;
     while (pos_ < data_.size() && !std::isspace(static_cast<unsigned char>(data_[pos_]))) ++pos_;
     tokenLine_ = line_;
-    return std::string_view(data_).substr(start, pos_ - start);
+    return data_.substr(start, pos_ - start);
   }
 
   long long integer(PlyType t, std::string_view token) const {
@@ -270,7 +270,7 @@ class AsciiCursor {
     return v;
   }
 
-  const std::string& data_;
+  std::string_view data_;
   size_t pos_;
   long long line_;
   long long tokenLine_ = 0;
@@ -282,7 +282,7 @@ class AsciiCursor {
 // Binary body: values in the file's byte order; bounds are checked before every read.
 class BinaryCursor {
  public:
-  BinaryCursor(const std::string& data, const PlyHeader& h, const std::string& path)
+  BinaryCursor(std::string_view data, const PlyHeader& h, const std::string& path)
       : bytes_(reinterpret_cast<const unsigned char*>(data.data())),
         size_(data.size()),
         pos_(h.bodyStart),
@@ -401,7 +401,8 @@ PlyMesh readBody(Cursor in, const PlyHeader& h) {
 }  // namespace
 
 Scene importPly(const std::string& path) {
-  const std::string data = readTextFile(path, "PLY file", kMaxPlyFileBytes);
+  const HugeBuffer bytes = readTextFile(path, "PLY file", kMaxPlyFileBytes);
+  const std::string_view data = bytes.view();
   PlyHeader header = parseHeader(data, path);
   checkCounts(header, data.size() - header.bodyStart, path);
   assignRoles(header, path);

@@ -25,6 +25,7 @@
 #include <string_view>
 #include <vector>
 
+#include "vox/core/huge_buffer.h"
 #include "vox/core/math.h"
 #include "vox/core/scene.h"
 
@@ -61,9 +62,9 @@ struct ObjData {
 // `word` quoted for a one-line message: at most 40 characters ("..." after), non-printing bytes as \xHH.
 std::string quotedWord(std::string_view word);
 
-// Reads a whole file into memory through readInputFile (input_file.h: regular files only, within the memory
-// budget). Throws InputError naming `path` when it cannot be read or is larger than `maxBytes`.
-std::string readTextFile(const std::string& path, const char* what, size_t maxBytes);
+// Reads a whole file into memory on huge pages through readInputBytes (input_file.h: regular files only, within
+// the memory budget). Throws InputError naming `path` when it cannot be read or is larger than `maxBytes`.
+HugeBuffer readTextFile(const std::string& path, const char* what, size_t maxBytes);
 
 // Texts of at least twice this many bytes are read in chunks of about this size, on all threads (obj_chunks.h).
 constexpr size_t kObjChunkBytes = size_t{1} << 19;

@@ -45,7 +45,7 @@ std::string quotedWord(std::string_view word) {
   return out;
 }
 
-std::string readTextFile(const std::string& path, const char* what, size_t maxBytes) {
+HugeBuffer readTextFile(const std::string& path, const char* what, size_t maxBytes) {
   requireRegularFile(path, what);
   std::error_code ec;
   const uintmax_t size = std::filesystem::file_size(path, ec);
@@ -53,7 +53,7 @@ std::string readTextFile(const std::string& path, const char* what, size_t maxBy
     fail<InputError>(path, ": ", what, " is ", bytes, " bytes, more than the limit of ", maxBytes, " bytes");
   };
   if (!ec && size > maxBytes) tooLarge(size);
-  std::string text = readInputFile(path, what);  // regular files only, within the memory budget
+  HugeBuffer text = readInputBytes(path, what);  // regular files only, within the memory budget
   if (text.size() > maxBytes) tooLarge(text.size());
   return text;
 }

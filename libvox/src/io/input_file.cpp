@@ -21,10 +21,18 @@ void requireRegularFile(const std::string& path, const char* what) {
     fail<InputError>(path, ": not a regular file (a device, FIFO or socket), expected the ", what);
 }
 
-std::string readInputFile(const std::string& path, const char* what) {
+namespace {
+
+// The file opened for reading once it is known to be a regular file whose bytes the memory budget can hold (twice:
+// a reader holds the bytes and what it makes of them). Opened once and checked again through the descriptor, so a
+// file swapped after the check is still a regular file of known size when read.
+struct OpenInput {
+  std::FILE* file = nullptr;
+  size_t size = 0;
+};
+
+OpenInput openInput(const std::string& path, const char* what) {
   requireRegularFile(path, what);
-  // Opened once and checked again through the descriptor, so a file swapped after the check is still a regular
-  // file of known size when read.
   std::FILE* file = std::fopen(path.c_str(), "rb");
   if (!file) fail<InputError>(path, ": cannot open ", what, ": ", std::strerror(errno));
   struct stat st {};
@@ -38,15 +46,45 @@ std::string readInputFile(const std::string& path, const char* what) {
     std::fclose(file);
     throw;
   }
-  // Reserved on huge pages before the first touch: a large mesh's text otherwise costs a 4 KiB page fault per page.
+  return {file, size_t(st.st_size)};
+}
+
+// Reads the opened file's `size` bytes into `into` and closes it; throws InputError when fewer can be read.
+void readAll(const OpenInput& in, char* into, const std::string& path) {
+  const size_t got = in.size == 0 ? 0 : std::fread(into, 1, in.size, in.file);
+  const bool error = std::ferror(in.file) != 0;
+  std::fclose(in.file);
+  if (error || got != in.size) fail<InputError>(path, ": read error after ", got, " bytes");
+}
+
+}  // namespace
+
+std::string readInputFile(const std::string& path, const char* what) {
+  const OpenInput in = openInput(path, what);
+  // Reserved on huge pages before the first touch: a large file's bytes otherwise cost a 4 KiB page fault per page.
   std::string bytes;
-  bytes.reserve(size_t(st.st_size));
-  adviseHugePages(bytes.data(), bytes.capacity());
-  bytes.resize(size_t(st.st_size));
-  const size_t got = bytes.empty() ? 0 : std::fread(bytes.data(), 1, bytes.size(), file);
-  const bool error = std::ferror(file) != 0;
-  std::fclose(file);
-  if (error || got != bytes.size()) fail<InputError>(path, ": read error after ", got, " bytes");
+  try {
+    bytes.reserve(in.size);
+    adviseHugePages(bytes.data(), bytes.capacity());
+    bytes.resize(in.size);
+  } catch (...) {
+    std::fclose(in.file);
+    throw;
+  }
+  readAll(in, bytes.data(), path);
+  return bytes;
+}
+
+HugeBuffer readInputBytes(const std::string& path, const char* what) {
+  const OpenInput in = openInput(path, what);
+  HugeBuffer bytes;
+  try {
+    bytes = HugeBuffer(in.size);
+  } catch (...) {
+    std::fclose(in.file);
+    throw;
+  }
+  readAll(in, bytes.data(), path);
   return bytes;
 }
 

@@ -7,6 +7,7 @@
 
 // The budget these checks hold reads to, and the quoting their messages use, are core's (other stages use them too);
 // included here for the readers, which use all of them together.
+#include "vox/core/huge_buffer.h"
 #include "vox/core/memory_budget.h"
 #include "vox/core/quote_input.h"
 
@@ -16,6 +17,10 @@ namespace vox {
 // (which could block forever or never end), unreadable, or larger than the memory budget allows (LimitError).
 // `what` names the file's role in messages ("scene file", "grid file").
 std::string readInputFile(const std::string& path, const char* what);
+
+// The same, into a buffer on huge pages, whole and not zeroed first (huge_buffer.h): for the large texts the
+// importers parse (OBJ, PLY), where the string's page faults and TLB misses cost more than the parse.
+HugeBuffer readInputBytes(const std::string& path, const char* what);
 
 // Throws InputError unless `path` names a regular file (checked before any importer opens it).
 void requireRegularFile(const std::string& path, const char* what);

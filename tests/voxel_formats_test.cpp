@@ -554,6 +554,20 @@ TEST(VoxelRuns, TallyCountsVoxelsAndRowsFromTheRunsAlone) {
   EXPECT_THROW(tallyVoxels(tooLarge), InputError);
 }
 
+// Cells of 1e-120 a side are a valid grid, but their volume underflows to 0 and OpenVDB's transform threw its own
+// exception through writeVdb (fuzz_voxel_writers, tests/data/fuzz/voxel_writers/vdb-zero-scale-394f3b71.bin).
+TEST(Vdb, CellsTooSmallForOpenVdbsTransformAreRefusedNamingTheirSides) {
+  Grid g = randomGrid({4, 4, 4}, 3, 10, 2);
+  g.bounds = {{0, 0, 0}, {4e-120, 4e-120, 4e-120}};
+  std::ostringstream out;
+  EXPECT_NE(limitMessage([&] { writeVdb(out, g); }).find("vdb: cells of 1e-120 x 1e-120 x 1e-120 are beyond OpenVDB"),
+            std::string::npos);
+  g.bounds = {{0, 0, 0}, {4e200, 4e200, 4e200}};  // a volume of 1e600 overflows
+  EXPECT_NE(limitMessage([&] { writeVdb(out, g); }).find("vdb: cells of 1e+200 x"), std::string::npos);
+  g.bounds = {{0, 0, 0}, {4, 4, 4}};
+  EXPECT_NO_THROW(writeVdb(out, g));
+}
+
 // The 906-byte grid of issue 23 (dims 2^21, no occupied cell, one run over all 2^63 cells): .vox ran past 40 s
 // with memory growing 3 MB/s, .vdb past 40 s, the meshes said "vector::reserve" (the estimate (occupied + solid) * 12
 // wrapped to 0).

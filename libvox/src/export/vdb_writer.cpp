@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <map>
 #include <vector>
 
@@ -24,6 +25,9 @@ namespace vox {
 
 namespace {
 
+// OpenVDB's map from index to world space: a cell's sides and its centre. Its constructor throws (an exception of
+// OpenVDB's own, which no caller expects) when the product of the sides is zero or not finite, as for cells of 1e-120
+// a side, which a grid may hold: refused here with the sides named.
 openvdb::math::Transform::Ptr cellTransform(const Grid& grid) {
   openvdb::Vec3d scale, translate;
   for (int a = 0; a < 3; ++a) {
@@ -31,8 +35,17 @@ openvdb::math::Transform::Ptr cellTransform(const Grid& grid) {
     scale[a] = side;
     translate[a] = grid.bounds.lo[a] + 0.5 * side;
   }
-  return std::make_shared<openvdb::math::Transform>(
-      std::make_shared<openvdb::math::ScaleTranslateMap>(scale, translate));
+  const double volume = scale[0] * scale[1] * scale[2];
+  const bool representable = std::isfinite(volume) && volume != 0 && std::isfinite(1 / volume) &&
+                             std::isfinite(translate[0] + translate[1] + translate[2]);
+  try {
+    if (representable)
+      return std::make_shared<openvdb::math::Transform>(
+          std::make_shared<openvdb::math::ScaleTranslateMap>(scale, translate));
+  } catch (const openvdb::Exception&) {
+  }
+  fail<LimitError>("vdb: cells of ", scale[0], " x ", scale[1], " x ", scale[2],
+                   " are beyond OpenVDB's transform (the product of a cell's sides must be a nonzero finite number)");
 }
 
 // OpenVDB's index space is signed 32-bit.

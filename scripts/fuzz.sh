@@ -4,7 +4,8 @@
 # targets at a time on a 2-core machine. Nothing is written into the repository outside BUILD_DIR.
 # Exits 1 naming each crashing (or leaking, hanging, out-of-memory) input when a target finds one.
 # Usage: scripts/fuzz.sh BUILD_DIR SECONDS (FUZZ_TARGETS="grid voxel_writers" to run only those, as issue 23's
-# 30-minute runs by hand did)
+# 30-minute runs by hand did; FUZZ_TOOLS=DIR makes the seed grids and meshes with the vox-voxelize and vox-export of
+# DIR, a build already made, instead of building instrumented ones here: CI passes its release build)
 set -euo pipefail
 [ $# -eq 2 ] || { echo "usage: scripts/fuzz.sh BUILD_DIR SECONDS" >&2; exit 1; }
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -16,7 +17,13 @@ read -r -a targets <<<"${FUZZ_TARGETS:-course obj ply gltf glb grid voxel_writer
 # -O1 -gline-tables-only, as OSS-Fuzz builds: about half the compile time of -O2 -g, and reports keep file:line.
 CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVOX_FUZZ=ON \
   "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only -DNDEBUG" -DVOX_TESTS=OFF >/dev/null
-ninja -C "$build" -j"$(nproc)" "${targets[@]/#/fuzz_}" vox-voxelize vox-export
+if [ -n "${FUZZ_TOOLS:-}" ]; then
+  tools=$(cd "$FUZZ_TOOLS" && pwd)
+  ninja -C "$build" -j"$(nproc)" "${targets[@]/#/fuzz_}"
+else
+  tools=$build
+  ninja -C "$build" -j"$(nproc)" "${targets[@]/#/fuzz_}" vox-voxelize vox-export
+fi
 
 run=$build/fuzz-run
 rm -rf "$run"
@@ -124,7 +131,7 @@ json.dump(gltf, open(sys.argv[3], "w"))
 EOF
 made_grid() {  # made_grid SCENE NAME [voxelize options]; a seed less if the scene is refused
   local scene=$1 name=$2; shift 2
-  "$build/vox-voxelize" "$scene" -o "$m/$name.vgrid" --quiet "$@" || echo "fuzz.sh: no seed $name.vgrid" >&2
+  "$tools/vox-voxelize" "$scene" -o "$m/$name.vgrid" --quiet "$@" || echo "fuzz.sh: no seed $name.vgrid" >&2
 }
 made_grid "$m/all.txt" all --res 6
 made_grid "$root/tests/data/unit_cube.obj" cube --grid 3 2 1 --method sat
@@ -135,7 +142,7 @@ made_grid "$m/all.txt" fill --res 4 --fill
 made_set() {  # made_set SCENE NAME [voxelize options]; a seed less if the scene is refused
   local scene=$1 name=$2; shift 2
   mkdir -p "$m/sets"
-  "$build/vox-voxelize" "$scene" -o "$m/sets/$name.vgrid" --quiet "$@" || { echo "fuzz.sh: no seed $name set" >&2; return 0; }
+  "$tools/vox-voxelize" "$scene" -o "$m/sets/$name.vgrid" --quiet "$@" || { echo "fuzz.sh: no seed $name set" >&2; return 0; }
   python3 - "$m/sets/$name.vgrid" "$m/${name}_set.vgrid" <<'PY'
 import glob, re, sys
 manifest, out = sys.argv[1], sys.argv[2]
@@ -154,8 +161,8 @@ made_set "$root/tests/data/unit_cube.obj" cube --grid 3 2 1 --method sat --brick
 made_set "$m/all.txt" fill --res 4 --fill --bricks 2 1 2
 for g in all cube spheres; do
   [ -f "$m/$g.vgrid" ] || continue
-  for ext in ply obj gltf glb; do "$build/vox-export" "$m/$g.vgrid" -o "$m/${g}_voxels.$ext" --faces merged --quiet; done
-  "$build/vox-export" "$m/$g.vgrid" -o "$m/${g}_ascii.ply" --ascii --faces exposed --quiet
+  for ext in ply obj gltf glb; do "$tools/vox-export" "$m/$g.vgrid" -o "$m/${g}_voxels.$ext" --faces merged --quiet; done
+  "$tools/vox-export" "$m/$g.vgrid" -o "$m/${g}_ascii.ply" --ascii --faces exposed --quiet
 done
 seed course "$m"/*.txt
 seed obj "$m"/*.obj

@@ -1,7 +1,6 @@
 // Logical lines of OBJ and MTL text (obj_text.h), and reading such a text file whole.
 #include "import/obj_text.h"
 
-#include <filesystem>
 #include <string>
 
 #include "import/obj_reader.h"
@@ -46,16 +45,7 @@ std::string quotedWord(std::string_view word) {
 }
 
 HugeBuffer readTextFile(const std::string& path, const char* what, size_t maxBytes) {
-  requireRegularFile(path, what);
-  std::error_code ec;
-  const uintmax_t size = std::filesystem::file_size(path, ec);
-  auto tooLarge = [&](uintmax_t bytes) {
-    fail<InputError>(path, ": ", what, " is ", bytes, " bytes, more than the limit of ", maxBytes, " bytes");
-  };
-  if (!ec && size > maxBytes) tooLarge(size);
-  HugeBuffer text = readInputBytes(path, what);  // regular files only, within the memory budget
-  if (text.size() > maxBytes) tooLarge(text.size());
-  return text;
+  return readInputBytes(path, what, maxBytes);  // regular files only, within the limit and the memory budget
 }
 
 }  // namespace vox

@@ -5,8 +5,10 @@
 
 #include <cerrno>
 #include <cstdio>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <memory>
 
 #include "vox/core/error.h"
 #include "vox/core/huge_pages.h"
@@ -23,67 +25,55 @@ void requireRegularFile(const std::string& path, const char* what) {
 
 namespace {
 
-// The file opened for reading once it is known to be a regular file whose bytes the memory budget can hold (twice:
-// a reader holds the bytes and what it makes of them). Opened once and checked again through the descriptor, so a
-// file swapped after the check is still a regular file of known size when read.
+struct CloseFile {
+  void operator()(std::FILE* f) const { std::fclose(f); }
+};
+
+// The file opened for reading once it is known to be a regular file of at most maxBytes whose bytes the memory
+// budget can hold (twice: a reader holds the bytes and what it makes of them). Opened once and checked again through
+// the descriptor, so a file swapped after the check is still a regular file of known size when read. Closed by its
+// handle on every path.
 struct OpenInput {
-  std::FILE* file = nullptr;
+  std::unique_ptr<std::FILE, CloseFile> file;
   size_t size = 0;
 };
 
-OpenInput openInput(const std::string& path, const char* what) {
+OpenInput openInput(const std::string& path, const char* what, size_t maxBytes) {
   requireRegularFile(path, what);
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (!file) fail<InputError>(path, ": cannot open ", what, ": ", std::strerror(errno));
+  OpenInput in{std::unique_ptr<std::FILE, CloseFile>(std::fopen(path.c_str(), "rb"))};
+  if (!in.file) fail<InputError>(path, ": cannot open ", what, ": ", std::strerror(errno));
   struct stat st {};
-  if (::fstat(::fileno(file), &st) != 0 || !S_ISREG(st.st_mode)) {
-    std::fclose(file);
+  if (::fstat(::fileno(in.file.get()), &st) != 0 || !S_ISREG(st.st_mode))
     fail<InputError>(path, ": not a regular file, not a ", what);
-  }
-  try {
-    checkMemory(2.0 * double(st.st_size), path, std::string("reading this ") + what);
-  } catch (...) {
-    std::fclose(file);
-    throw;
-  }
-  return {file, size_t(st.st_size)};
+  in.size = size_t(st.st_size);
+  if (in.size > maxBytes)
+    fail<InputError>(path, ": ", what, " is ", in.size, " bytes, more than the limit of ", maxBytes, " bytes");
+  checkMemory(2.0 * double(st.st_size), path, std::string("reading this ") + what);
+  return in;
 }
 
-// Reads the opened file's `size` bytes into `into` and closes it; throws InputError when fewer can be read.
+// Reads the opened file's `size` bytes into `into`; throws InputError when fewer can be read.
 void readAll(const OpenInput& in, char* into, const std::string& path) {
-  const size_t got = in.size == 0 ? 0 : std::fread(into, 1, in.size, in.file);
-  const bool error = std::ferror(in.file) != 0;
-  std::fclose(in.file);
-  if (error || got != in.size) fail<InputError>(path, ": read error after ", got, " bytes");
+  const size_t got = in.size == 0 ? 0 : std::fread(into, 1, in.size, in.file.get());
+  if (std::ferror(in.file.get()) != 0 || got != in.size) fail<InputError>(path, ": read error after ", got, " bytes");
 }
 
 }  // namespace
 
 std::string readInputFile(const std::string& path, const char* what) {
-  const OpenInput in = openInput(path, what);
+  const OpenInput in = openInput(path, what, SIZE_MAX);
   // Reserved on huge pages before the first touch: a large file's bytes otherwise cost a 4 KiB page fault per page.
   std::string bytes;
-  try {
-    bytes.reserve(in.size);
-    adviseHugePages(bytes.data(), bytes.capacity());
-    bytes.resize(in.size);
-  } catch (...) {
-    std::fclose(in.file);
-    throw;
-  }
+  bytes.reserve(in.size);
+  adviseHugePages(bytes.data(), bytes.capacity());
+  bytes.resize(in.size);
   readAll(in, bytes.data(), path);
   return bytes;
 }
 
-HugeBuffer readInputBytes(const std::string& path, const char* what) {
-  const OpenInput in = openInput(path, what);
-  HugeBuffer bytes;
-  try {
-    bytes = HugeBuffer(in.size);
-  } catch (...) {
-    std::fclose(in.file);
-    throw;
-  }
+HugeBuffer readInputBytes(const std::string& path, const char* what, size_t maxBytes) {
+  const OpenInput in = openInput(path, what, maxBytes);
+  HugeBuffer bytes(in.size);
   readAll(in, bytes.data(), path);
   return bytes;
 }

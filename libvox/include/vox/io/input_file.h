@@ -19,8 +19,9 @@ namespace vox {
 std::string readInputFile(const std::string& path, const char* what);
 
 // The same, into a buffer on huge pages, whole and not zeroed first (huge_buffer.h): for the large texts the
-// importers parse (OBJ, PLY), where the string's page faults and TLB misses cost more than the parse.
-HugeBuffer readInputBytes(const std::string& path, const char* what);
+// importers parse (OBJ, PLY), where the string's page faults and TLB misses cost more than the parse. A file of more
+// than maxBytes is refused before it is read: "PATH: WHAT is N bytes, more than the limit of M bytes".
+HugeBuffer readInputBytes(const std::string& path, const char* what, size_t maxBytes = SIZE_MAX);
 
 // Throws InputError unless `path` names a regular file (checked before any importer opens it).
 void requireRegularFile(const std::string& path, const char* what);

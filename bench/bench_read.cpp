@@ -12,6 +12,8 @@
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
 
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -29,31 +31,46 @@ using OpenMeshTriangles = OpenMesh::TriMesh_ArrayKernelT<>;
 
 double seconds(Clock::time_point since) { return std::chrono::duration<double>(Clock::now() - since).count(); }
 
-// The child: one load of `path` by `who` ("ours" or "omesh") on `threads` threads; prints "SECONDS COUNT".
+long minorFaults() {
+  rusage usage{};
+  ::getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_minflt;
+}
+
+// The child: one load of `path` by `who` ("ours" or "omesh") on `threads` threads; prints "SECONDS COUNT MINOR_FAULTS"
+// (the page faults of the load itself).
 int child(const std::string& who, int threads, const std::string& path) {
   const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
   tbb::parallel_for(0, threads, [](int) {});  // the worker threads started before the clock
+  const long faultsBefore = minorFaults();
   const auto start = Clock::now();
   size_t count = 0;
+  double loaded = 0;
+  long faults = 0;
   if (who == "ours") {
-    count = vox::loadScene(path).triangles.size();
+    const vox::Scene scene = vox::loadScene(path);  // timed without its release, as a tool holds it
+    loaded = seconds(start);
+    faults = minorFaults() - faultsBefore;
+    count = scene.triangles.size();
   } else {
     OpenMeshTriangles mesh;
     if (!OpenMesh::IO::read_mesh(mesh, path)) return 1;
+    loaded = seconds(start);
+    faults = minorFaults() - faultsBefore;
     count = mesh.n_faces();
   }
-  std::printf("%.9f %zu\n", seconds(start), count);
+  std::printf("%.9f %zu %ld\n", loaded, count, faults);
   return 0;
 }
 
 // One load in a fresh process: its seconds (or a negative number when it failed) and what it counted.
-double timeInChild(const std::string& self, const std::string& who, int threads, const std::string& path,
-                   size_t& count) {
+double timeInChild(const std::string& self, const std::string& who, int threads, const std::string& path, size_t& count,
+                   long& faults) {
   const std::string command = "'" + self + "' --child " + who + " " + std::to_string(threads) + " '" + path + "'";
   std::FILE* pipe = ::popen(command.c_str(), "r");
   if (!pipe) return -1;
   double s = -1;
-  if (std::fscanf(pipe, "%lf %zu", &s, &count) != 2) s = -1;
+  if (std::fscanf(pipe, "%lf %zu %ld", &s, &count, &faults) != 3) s = -1;
   return ::pclose(pipe) == 0 ? s : -1;
 }
 
@@ -67,6 +84,10 @@ int main(int argc, char** argv) {
   std::vector<std::string> files;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
+    if (a == "--help" || a == "-h") {
+      std::printf("usage: bench_read [--runs N] [--ours-only] [FILE...]\n");
+      return 0;
+    }
     if (a == "--ours-only")
       oursOnly = true;
     else if (a == "--runs" && i + 1 < argc)
@@ -86,13 +107,17 @@ int main(int argc, char** argv) {
     const double mb = double(std::filesystem::file_size(f)) / 1e6;
     double one = 1e30, all = 1e30, theirs = 1e30;
     size_t ourTriangles = 0, theirFaces = 0;
-    auto best = [](double& into, double t) {
-      if (t >= 0) into = std::min(into, t);
+    long faults = 0, oneFaults = 0, allFaults = 0, theirFaults = 0;
+    auto best = [&faults](double& into, long& intoFaults, double t) {
+      if (t >= 0 && t < into) {
+        into = t;
+        intoFaults = faults;
+      }
     };
     for (int r = 0; r < runs; ++r) {  // alternating, so that a noisy moment hits all three
-      best(one, timeInChild(self, "ours", 1, f, ourTriangles));
-      best(all, timeInChild(self, "ours", threads, f, ourTriangles));
-      if (!oursOnly) best(theirs, timeInChild(self, "omesh", 1, f, theirFaces));
+      best(one, oneFaults, timeInChild(self, "ours", 1, f, ourTriangles, faults));
+      best(all, allFaults, timeInChild(self, "ours", threads, f, ourTriangles, faults));
+      if (!oursOnly) best(theirs, theirFaults, timeInChild(self, "omesh", 1, f, theirFaces, faults));
     }
     if (one >= 1e30 || all >= 1e30) {
       std::fprintf(stderr, "bench_read: %s: our reader failed\n", f.c_str());
@@ -104,7 +129,8 @@ int main(int argc, char** argv) {
       std::printf(" %9.2f %10.0f %7.2f", theirs * 1e3, mb / theirs, theirs / all);
     else
       std::printf(" %9s %10s %7s", "-", "-", "-");
-    std::printf("  (%zu triangles; OpenMesh %zu faces)\n", ourTriangles, theirFaces);
+    std::printf("  (%zu triangles; OpenMesh %zu faces; page faults of the best loads %ld, %ld, %ld)\n", ourTriangles,
+                theirFaces, oneFaults, allFaults, theirFaults);
   }
   return 0;
 }

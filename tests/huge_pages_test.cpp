@@ -86,6 +86,28 @@ TEST(HugePages, LargeObjReadsBackBitForBit) {
   }
 }
 
+// HugeVector keeps every value across the threshold between operator new and whole huge pages, through growth one
+// element at a time, copies, moves and shrinking; its large blocks start on a 2 MiB boundary.
+TEST(HugePages, HugeVectorHoldsItsValuesOnBothSidesOfTheThreshold) {
+  const size_t atThreshold = kHugeAllocationMin / sizeof(uint64_t);
+  for (size_t n : {size_t{0}, size_t{1}, atThreshold - 1, atThreshold, atThreshold + 1, 3 * kHugePageBytes / 8 + 5}) {
+    HugeVector<uint64_t> grown;
+    for (uint64_t i = 0; i < n; ++i) grown.push_back(i * 0x9E3779B97F4A7C15u);
+    HugeVector<uint64_t> sized(n);
+    for (uint64_t i = 0; i < n; ++i) sized[i] = i * 0x9E3779B97F4A7C15u;
+    ASSERT_EQ(grown, sized) << n;
+    if (n * sizeof(uint64_t) >= kHugeAllocationMin) {
+      EXPECT_EQ(reinterpret_cast<uintptr_t>(sized.data()) % kHugePageBytes, 0u) << n;
+    }
+    const HugeVector<uint64_t> copy = grown;
+    HugeVector<uint64_t> moved = std::move(grown);
+    ASSERT_EQ(copy, moved) << n;
+    moved.resize(n / 3);
+    moved.shrink_to_fit();  // from a huge block to a small one, or to none
+    for (size_t i = 0; i < moved.size(); ++i) ASSERT_EQ(moved[i], copy[i]) << n;
+  }
+}
+
 TEST(HugeBuffer, HoldsEveryByteOfItsSizeOnWholeHugePages) {
   constexpr size_t kHuge = size_t{2} << 20;
   for (size_t size : {size_t{0}, size_t{1}, kHuge - 1, kHuge, kHuge + 1, 5 * kHuge + 12345}) {

@@ -79,7 +79,7 @@ void expectNear(const Vec3& a, const Vec3& b, double tol = 1e-12) {
   EXPECT_NEAR(a.z, b.z, tol);
 }
 
-bool hasVertex(const std::vector<Triangle>& tris, const Vec3& p, double tol = 1e-12) {
+bool hasVertex(const HugeVector<Triangle>& tris, const Vec3& p, double tol = 1e-12) {
   for (const auto& t : tris)
     for (const auto& v : t.v)
       if (std::fabs(v.x - p.x) <= tol && std::fabs(v.y - p.y) <= tol && std::fabs(v.z - p.z) <= tol) return true;
@@ -172,7 +172,7 @@ TEST(ImportCourse, Scene5_11RotatedTriangle) {
 TEST(ImportCourse, Scene5_12NestedTransformsComposeOutermostFirst) {
   const Scene s = loadScene(course("scene5_12_nested_transformations.txt"));
   ASSERT_EQ(s.triangles.size(), 36u);  // three cube.obj
-  std::vector<Triangle> byMaterial[3];
+  HugeVector<Triangle> byMaterial[3];
   for (const auto& t : s.triangles) byMaterial[t.material].push_back(t);
   ASSERT_EQ(byMaterial[0].size(), 12u);
   ASSERT_EQ(byMaterial[2].size(), 12u);
@@ -851,7 +851,7 @@ std::string g17(double x) {
 }
 
 // Expects triangle t's corners to hold values[9t .. 9t+8] bit for bit.
-void expectTrianglesHold(const std::vector<Triangle>& tris, const std::vector<double>& values) {
+void expectTrianglesHold(const HugeVector<Triangle>& tris, const std::vector<double>& values) {
   ASSERT_EQ(tris.size() * 9, values.size());
   for (size_t i = 0; i < values.size(); ++i) {
     const double got = tris[i / 9].v[(i / 3) % 3][static_cast<int>(i % 3)];

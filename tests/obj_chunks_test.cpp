@@ -85,11 +85,22 @@ TEST(ObjChunks, ChunksEndWhereLogicalLinesEndAndCountWhatCameBefore) {
   const long long lines[] = {0, 1, 2, 4, 6, 7, 8, 9};
   const size_t vertices[] = {0, 1, 1, 2, 2, 2, 3, 3};
   const size_t texcoords[] = {0, 0, 1, 1, 1, 2, 2, 2};
+  const size_t trianglesBefore[] = {0, 0, 0, 0, 1, 1, 1, 1};
+  const size_t ownVertices[] = {1, 0, 1, 0, 0, 1, 0, 1};
+  const size_t ownTriangles[] = {0, 0, 0, 1, 0, 0, 0, 0};
   for (size_t k = 0; k < chunks.size(); ++k) {
     EXPECT_EQ(chunks[k].linesBefore, lines[k]) << k;
     EXPECT_EQ(chunks[k].verticesBefore, vertices[k]) << k;
     EXPECT_EQ(chunks[k].texcoordsBefore, texcoords[k]) << k;
+    EXPECT_EQ(chunks[k].trianglesBefore, trianglesBefore[k]) << k;
+    EXPECT_EQ(chunks[k].vertices, ownVertices[k]) << k;
+    EXPECT_EQ(chunks[k].triangles, ownTriangles[k]) << k;
   }
+  // A polygon of n corners counts n - 2 triangles, a comment ends its corners, and a face of fewer than 3 counts
+  // none (the parser reports it).
+  const std::vector<ObjChunk> faces = cutObjText("f 1 2 3 4 5 # 6 7\nf 1 2\nf 1 2 3\n", 1000);
+  ASSERT_EQ(faces.size(), 1u);
+  EXPECT_EQ(faces[0].triangles, 4u);
   // A text shorter than two chunks is one piece.
   EXPECT_EQ(cutObjText(text, text.size() / 2 + 1).size(), 1u);
   EXPECT_EQ(cutObjText("", 1).size(), 0u);
@@ -113,7 +124,7 @@ TEST(ObjChunks, IndicesMaterialsAndTexcoordsAcrossChunks) {
   EXPECT_EQ(r.data.triangles.size(), 6u);
   EXPECT_EQ(r.data.materialNames, (std::vector<std::string>{"red", "green", "blue"}));
   EXPECT_EQ(r.data.materialLines, (std::vector<long long>{8, 15, 21}));
-  EXPECT_EQ(r.data.triangleMaterial, (std::vector<uint32_t>{kNoObjMaterial, 0, 0, 1, 1, 0}));
+  EXPECT_EQ(r.data.triangleMaterial, (HugeVector<uint32_t>{kNoObjMaterial, 0, 0, 1, 1, 0}));
   ASSERT_EQ(r.data.triangleTexcoords.size(), 6u);
   EXPECT_EQ(r.data.triangleTexcoords[1][0], kNoObjTexcoord);
   EXPECT_EQ(r.data.triangleTexcoords[2], (std::array<uint32_t, 3>{2, 1, 0}));

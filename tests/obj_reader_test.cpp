@@ -182,7 +182,7 @@ TEST(ObjReader, ContinuationsCommentsCrlfAndSkippedStatements) {
   EXPECT_EQ(d.vertices[2].z, 9);
   ASSERT_EQ(d.triangles.size(), 3u);
   ASSERT_EQ(d.materialNames, (std::vector<std::string>{"red", "green"}));
-  EXPECT_EQ(d.triangleMaterial, (std::vector<uint32_t>{0, 1, 0}));
+  EXPECT_EQ(d.triangleMaterial, (HugeVector<uint32_t>{0, 1, 0}));
   ASSERT_EQ(d.libraries.size(), 2u);
   EXPECT_EQ(d.libraries[1].name, "b.mtl");
   EXPECT_EQ(d.libraries[1].line, 2);

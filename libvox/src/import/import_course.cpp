@@ -65,7 +65,7 @@ std::optional<long long> parseInteger(std::string_view s) {
 // ---- scene parser ----
 
 struct Primitives {
-  std::vector<Triangle> triangles;
+  HugeVector<Triangle> triangles;
   std::vector<Sphere> spheres;
   std::vector<Plane> planes;
 };

@@ -202,8 +202,8 @@ void checkCounts(const PlyHeader& h, size_t bodyBytes, const std::string& path) 
 }
 
 struct PlyMesh {
-  std::vector<Vec3> vertices;
-  std::vector<std::array<uint32_t, 3>> triangles;
+  HugeVector<Vec3> vertices;
+  HugeVector<std::array<uint32_t, 3>> triangles;
   long long shortFaces = 0;  // faces with fewer than 3 vertices, skipped
 };
 
@@ -243,15 +243,19 @@ class AsciiCursor {
   }
 
  private:
+  // The C locale's white space, spelled out: std::isspace is a library call per byte (13% of a PLY's reading) and
+  // follows a locale a program may have changed.
+  static bool isSpace(char c) { return c == ' ' || (c >= '\t' && c <= '\r'); }
+
   std::string_view next() {
-    while (pos_ < data_.size() && std::isspace(static_cast<unsigned char>(data_[pos_]))) {
+    while (pos_ < data_.size() && isSpace(data_[pos_])) {
       if (data_[pos_] == '\n') ++line_;
       ++pos_;
     }
     if (pos_ >= data_.size())
       fail<InputError>(path_, ": PLY file ends inside ", element_->name, " ", index_, " (truncated?)");
     const size_t start = pos_;
-    while (pos_ < data_.size() && !std::isspace(static_cast<unsigned char>(data_[pos_]))) ++pos_;
+    while (pos_ < data_.size() && !isSpace(data_[pos_])) ++pos_;
     tokenLine_ = line_;
     return data_.substr(start, pos_ - start);
   }

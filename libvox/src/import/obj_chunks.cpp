@@ -23,11 +23,13 @@ bool continuesAt(std::string_view text, size_t eol) {
   return end > 0 && text[end - 1] == '\\';
 }
 
-// Counts the chunk's `v` and `vt` statements and physical lines into its fields (the "before" counts of the next).
+// The chunk's physical lines, `v` and `vt` statements and the triangles of its `f` statements (the "before" counts
+// of the next chunk), with the words the parser reads.
 struct ChunkCounts {
   long long lines = 0;
   size_t vertices = 0;
   size_t texcoords = 0;
+  size_t triangles = 0;
 };
 
 ChunkCounts countChunk(std::string_view text) {
@@ -36,11 +38,17 @@ ChunkCounts countChunk(std::string_view text) {
   std::string_view line;
   long long number = 0;
   while (lines.next(line, number)) {
-    const std::string_view keyword = Words{line}.next();
-    if (keyword == "v")
+    Words words{line};
+    const std::string_view keyword = words.next();
+    if (keyword == "v") {
       ++counts.vertices;
-    else if (keyword == "vt")
+    } else if (keyword == "vt") {
       ++counts.texcoords;
+    } else if (keyword == "f") {
+      size_t corners = 0;
+      while (!words.next().empty()) ++corners;
+      if (corners >= 3) counts.triangles += corners - 2;  // fewer is an error the parser reports
+    }
   }
   counts.lines = lines.physicalLines();
   return counts;
@@ -87,8 +95,8 @@ std::vector<std::vector<uint32_t>> joinMaterials(std::vector<ObjChunkResult>& pa
   return global;
 }
 
-// Each triangle's material as a file-wide id: chunk-local ids mapped, kObjMaterialBefore resolved to the material
-// in use where the chunk began.
+// Each triangle's material as a file-wide id, in place: chunk-local ids mapped, kObjMaterialBefore resolved to the
+// material in use where the chunk began.
 void joinTriangleMaterials(std::vector<ObjChunkResult>& parts, ObjData& out) {
   const std::vector<std::vector<uint32_t>> global = joinMaterials(parts, out);
   std::vector<uint32_t> atStart(parts.size(), kNoObjMaterial);
@@ -97,9 +105,10 @@ void joinTriangleMaterials(std::vector<ObjChunkResult>& parts, ObjData& out) {
     atStart[k] = end == kObjMaterialBefore ? atStart[k - 1] : global[k - 1][end];
   }
   tbb::parallel_for(size_t(0), parts.size(), [&](size_t k) {
-    for (uint32_t& m : parts[k].data.triangleMaterial) m = m == kObjMaterialBefore ? atStart[k] : global[k][m];
+    uint32_t* const first = out.triangleMaterial.data() + parts[k].trianglesBefore;
+    for (uint32_t* m = first; m != first + parts[k].triangleCount; ++m)
+      *m = *m == kObjMaterialBefore ? atStart[k] : global[k][*m];
   });
-  joinArrays(parts, &ObjData::triangleMaterial, out.triangleMaterial);
 }
 
 // Texture coordinates per triangle: none when no chunk has them, else one entry per triangle of the file.
@@ -109,7 +118,7 @@ void joinTriangleTexcoords(std::vector<ObjChunkResult>& parts, ObjData& out) {
   if (!any) return;
   constexpr std::array<uint32_t, 3> none = {kNoObjTexcoord, kNoObjTexcoord, kNoObjTexcoord};
   for (ObjChunkResult& p : parts)
-    if (p.data.triangleTexcoords.empty()) p.data.triangleTexcoords.assign(p.data.triangles.size(), none);
+    if (p.data.triangleTexcoords.empty()) p.data.triangleTexcoords.assign(p.triangleCount, none);
   joinArrays(parts, &ObjData::triangleTexcoords, out.triangleTexcoords);
 }
 
@@ -128,25 +137,24 @@ std::vector<ObjChunk> cutObjText(std::string_view text, size_t chunkBytes) {
     chunks.push_back({text.substr(begin, end - begin)});
     begin = end;
   }
-  if (chunks.size() < 2) return chunks;
   std::vector<ChunkCounts> counts(chunks.size());
-  tbb::parallel_for(size_t(0), chunks.size() - 1, [&](size_t k) { counts[k] = countChunk(chunks[k].text); });
-  for (size_t k = 1; k < chunks.size(); ++k) {
+  tbb::parallel_for(size_t(0), chunks.size(), [&](size_t k) { counts[k] = countChunk(chunks[k].text); });
+  for (size_t k = 0; k < chunks.size(); ++k) {
+    chunks[k].vertices = counts[k].vertices;
+    chunks[k].triangles = counts[k].triangles;
+    if (k == 0) continue;
     chunks[k].linesBefore = chunks[k - 1].linesBefore + counts[k - 1].lines;
     chunks[k].verticesBefore = chunks[k - 1].verticesBefore + counts[k - 1].vertices;
     chunks[k].texcoordsBefore = chunks[k - 1].texcoordsBefore + counts[k - 1].texcoords;
+    chunks[k].trianglesBefore = chunks[k - 1].trianglesBefore + counts[k - 1].triangles;
   }
   return chunks;
 }
 
-ObjData joinObjChunks(std::vector<ObjChunkResult>& parts, const std::string& path) {
-  ObjData out;
-  size_t vertexCount = 0;
+void joinObjChunks(std::vector<ObjChunkResult>& parts, const std::string& path, ObjData& out) {
+  const size_t vertexCount = out.vertices.size();
   size_t texcoordCount = 0;
-  for (const ObjChunkResult& p : parts) {
-    vertexCount += p.data.vertices.size();
-    texcoordCount += p.data.texcoords.size();
-  }
+  for (const ObjChunkResult& p : parts) texcoordCount += p.data.texcoords.size();
   // Positive indices may name vertices defined further down; judged now, in file order, as one-piece reading does.
   for (const ObjChunkResult& p : parts)
     for (const ObjForwardIndex& f : p.forward)
@@ -174,10 +182,7 @@ ObjData joinObjChunks(std::vector<ObjChunkResult>& parts, const std::string& pat
 
   joinTriangleMaterials(parts, out);
   if (texcoordCount > 0) joinTriangleTexcoords(parts, out);
-  joinArrays(parts, &ObjData::vertices, out.vertices);
-  joinArrays(parts, &ObjData::triangles, out.triangles);
   joinArrays(parts, &ObjData::texcoords, out.texcoords);
-  return out;
 }
 
 }  // namespace vox

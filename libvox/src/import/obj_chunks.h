@@ -16,16 +16,21 @@
 
 namespace vox {
 
-// A chunk of an OBJ text and what its parse needs to know of the text before it.
+// A chunk of an OBJ text, what its parse needs to know of the text before it, and where its vertices and triangles
+// go in the file's arrays: each chunk writes its own part of them, so that nothing is copied when the chunks are
+// joined and no array is grown (a growing array is fresh memory each time it moves: docs/voxelize-speed.md).
 struct ObjChunk {
   std::string_view text;
   long long linesBefore = 0;   // physical lines
   size_t verticesBefore = 0;   // `v` statements
   size_t texcoordsBefore = 0;  // `vt` statements
+  size_t trianglesBefore = 0;  // triangles of `f` statements (a face of n corners makes n - 2)
+  size_t vertices = 0;         // the chunk's own `v` statements
+  size_t triangles = 0;        // and triangles; exact for a text that reads without error
 };
 
-// Chunks of about chunkBytes (the whole text in one below 2 * chunkBytes), each ending where a logical line ends.
-// Counting runs in parallel.
+// Chunks of about chunkBytes (the whole text in one below 2 * chunkBytes), each ending where a logical line ends,
+// every one counted. Counting runs in parallel.
 std::vector<ObjChunk> cutObjText(std::string_view text, size_t chunkBytes);
 
 // A face's material before any `usemtl` in its chunk: the one in use where the previous chunk ended.
@@ -38,11 +43,14 @@ struct ObjForwardIndex {
   long long written;
 };
 
-// One chunk's reading. `data` as parseObj's, except: triangleMaterial holds indices into this chunk's
-// data.materialNames (in this chunk's order of first use) or kObjMaterialBefore; triangleTexcoords is empty or holds
-// one entry per triangle of the chunk; data.warnings is empty (unknown keywords are counted here instead).
+// One chunk's reading. `data` as parseObj's, except: the file's triangleMaterial holds, over the chunk's triangles,
+// indices into this chunk's data.materialNames (in this chunk's order of first use) or kObjMaterialBefore;
+// triangleTexcoords is empty or holds one entry per triangle of the chunk; data.warnings is empty (unknown keywords
+// are counted here instead).
 struct ObjChunkResult {
-  ObjData data;
+  ObjData data;  // vertices, triangles and triangleMaterial stay empty: the chunk writes them into the file's
+  size_t trianglesBefore = 0;
+  size_t triangleCount = 0;
   uint32_t materialAtEnd = kObjMaterialBefore;
   std::vector<ObjForwardIndex> forward;
   std::vector<ObjForwardIndex> forwardTex;
@@ -51,8 +59,10 @@ struct ObjChunkResult {
   long long firstUnknownLine = 0;
 };
 
-// The chunks' results joined in file order (arrays copied in parallel); throws InputError "path:line: ..." for the
-// first out-of-range forward index, vertex indices before texture coordinate ones, as one-piece reading does.
-ObjData joinObjChunks(std::vector<ObjChunkResult>& parts, const std::string& path);
+// Joins the chunks' results into `out`, whose vertices, triangles and triangleMaterial the chunks wrote, in file
+// order (materials renumbered in place, texture coordinates copied, in parallel); throws InputError "path:line: ..."
+// for the first out-of-range forward index, vertex indices before texture coordinate ones, as one-piece reading
+// does.
+void joinObjChunks(std::vector<ObjChunkResult>& parts, const std::string& path, ObjData& out);
 
 }  // namespace vox

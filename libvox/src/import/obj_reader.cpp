@@ -16,22 +16,35 @@
 #include "import/obj_text.h"
 #include "vox/core/error.h"
 #include "vox/core/huge_pages.h"
+#include "vox/core/memory_budget.h"
 
 namespace vox {
 namespace {
 
 class ObjParser {
  public:
-  ObjParser(const ObjChunk& chunk, const std::string& path)
+  // Writes the chunk's vertices, triangles and their materials into `file`'s arrays, sized by the counting pass.
+  ObjParser(const ObjChunk& chunk, const std::string& path, ObjData& file)
       : lines_(chunk.text, chunk.linesBefore),
         path_(path),
         verticesBefore_(chunk.verticesBefore),
-        texcoordsBefore_(chunk.texcoordsBefore) {}
+        texcoordsBefore_(chunk.texcoordsBefore),
+        vertexCapacity_(chunk.vertices),
+        triangleCapacity_(chunk.triangles),
+        vertices_(file.vertices.data() + chunk.verticesBefore),
+        triangles_(file.triangles.data() + chunk.trianglesBefore),
+        materials_(file.triangleMaterial.data() + chunk.trianglesBefore) {
+    out_.trianglesBefore = chunk.trianglesBefore;
+  }
 
   ObjChunkResult run() {
     std::string_view line;
     long long number = 0;
     while (lines_.next(line, number)) statement(Words{line}, number);
+    // The counting pass reads the same words; a difference would be a bug in one of them, not in the file.
+    if (vertexCount_ != vertexCapacity_ || out_.triangleCount != triangleCapacity_)
+      fail<Error>(path_, ": the OBJ reader counted ", vertexCapacity_, " vertices and ", triangleCapacity_,
+                  " triangles in a chunk but read ", vertexCount_, " and ", out_.triangleCount, " (a bug in libvox)");
     return std::move(out_);
   }
 
@@ -76,8 +89,8 @@ class ObjParser {
       double ignored = 0;
       if (!parseObjNumber(w, ignored)) failAt(line, "bad number ", quotedWord(w));
     }
-    growOnHugePages(data_.vertices);
-    data_.vertices.push_back({xyz[0], xyz[1], xyz[2]});
+    if (vertexCount_ == vertexCapacity_) failAt(line, "more vertices than counted (a bug in libvox)");
+    vertices_[vertexCount_++] = {xyz[0], xyz[1], xyz[2]};
   }
 
   // `vt u [v [w]]`: u and v kept exactly as written.
@@ -131,7 +144,7 @@ class ObjParser {
     }
     long long i = 0;
     const IntegerStatus status = parseObjInteger(head, i);
-    const long long seen = static_cast<long long>(verticesBefore_ + data_.vertices.size());
+    const long long seen = static_cast<long long>(verticesBefore_ + vertexCount_);
     if (status == IntegerStatus::Bad) failAt(line, "bad face index ", quotedWord(word));
     if (status == IntegerStatus::TooLarge)
       failAt(line, "face index ", quotedWord(head), " out of range (", seen, " vertices)");
@@ -154,14 +167,15 @@ class ObjParser {
       textured &= tex != kNoObjTexcoord;
     }
     if (polygon_.size() < 3) failAt(line, "face needs at least 3 vertices");
+    if (polygon_.size() - 2 > triangleCapacity_ - out_.triangleCount)
+      failAt(line, "more triangles than counted (a bug in libvox)");
     for (size_t k = 1; k + 1 < polygon_.size(); ++k) {
-      growOnHugePages(data_.triangles);
-      growOnHugePages(data_.triangleMaterial);
-      data_.triangles.push_back({polygon_[0], polygon_[k], polygon_[k + 1]});
-      data_.triangleMaterial.push_back(currentMaterial_);
+      const size_t t = out_.triangleCount++;
+      triangles_[t] = {polygon_[0], polygon_[k], polygon_[k + 1]};
+      materials_[t] = currentMaterial_;
       if (textured) {
         // Texture coordinates appear with the first face that has them; earlier faces get none.
-        data_.triangleTexcoords.resize(data_.triangles.size() - 1, {kNoObjTexcoord, kNoObjTexcoord, kNoObjTexcoord});
+        data_.triangleTexcoords.resize(t, {kNoObjTexcoord, kNoObjTexcoord, kNoObjTexcoord});
         data_.triangleTexcoords.push_back({polygonTex_[0], polygonTex_[k], polygonTex_[k + 1]});
       } else if (!data_.triangleTexcoords.empty()) {
         data_.triangleTexcoords.push_back({kNoObjTexcoord, kNoObjTexcoord, kNoObjTexcoord});
@@ -184,6 +198,12 @@ class ObjParser {
   const std::string& path_;
   const size_t verticesBefore_;
   const size_t texcoordsBefore_;
+  const size_t vertexCapacity_;
+  const size_t triangleCapacity_;
+  Vec3* const vertices_;  // the chunk's part of the file's arrays
+  std::array<uint32_t, 3>* const triangles_;
+  uint32_t* const materials_;
+  size_t vertexCount_ = 0;
   ObjChunkResult out_;
   ObjData& data_ = out_.data;
   std::vector<uint32_t> polygon_;                          // the corners of the face being read
@@ -196,6 +216,19 @@ class ObjParser {
 
 ObjData parseObj(std::string_view text, const std::string& path, size_t chunkBytes) {
   const std::vector<ObjChunk> chunks = cutObjText(text, std::max<size_t>(chunkBytes, 1));
+  ObjData file;
+  if (!chunks.empty()) {
+    const size_t vertices = chunks.back().verticesBefore + chunks.back().vertices;
+    const size_t triangles = chunks.back().trianglesBefore + chunks.back().triangles;
+    // Counted before a word is checked: a text of bare `v` lines asks for 12 times its size before its first line
+    // fails, so the sizes are checked against the memory there is first.
+    checkMemory(double(vertices) * sizeof(Vec3) + double(triangles) * (sizeof(file.triangles[0]) + sizeof(uint32_t)),
+                path,
+                "reading " + std::to_string(vertices) + " vertices and " + std::to_string(triangles) + " triangles");
+    file.vertices.resize(vertices);
+    file.triangles.resize(triangles);
+    file.triangleMaterial.resize(triangles);
+  }
   std::vector<ObjChunkResult> parts(chunks.size());
   std::vector<std::exception_ptr> errors(chunks.size());
   std::atomic<size_t> firstError{chunks.size()};  // chunks after a failed one need not be read
@@ -204,7 +237,7 @@ ObjData parseObj(std::string_view text, const std::string& path, size_t chunkByt
       [&](size_t k) {
         if (k > firstError.load()) return;
         try {
-          parts[k] = ObjParser(chunks[k], path).run();
+          parts[k] = ObjParser(chunks[k], path, file).run();
         } catch (...) {
           errors[k] = std::current_exception();
           size_t seen = firstError.load();
@@ -216,7 +249,8 @@ ObjData parseObj(std::string_view text, const std::string& path, size_t chunkByt
   // The first error of the file, as one-piece reading would meet it.
   for (const std::exception_ptr& e : errors)
     if (e) std::rethrow_exception(e);
-  return joinObjChunks(parts, path);
+  joinObjChunks(parts, path, file);
+  return file;
 }
 
 }  // namespace vox

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "vox/core/huge_buffer.h"
+#include "vox/core/huge_pages.h"
 #include "vox/core/math.h"
 #include "vox/core/scene.h"
 
@@ -46,9 +47,9 @@ struct ObjLibrary {
 // One OBJ file's geometry. triangles[i] holds 0-based indices into `vertices`, all in range;
 // triangleMaterial[i] indexes `materialNames` or is kNoObjMaterial (no `usemtl` before the face).
 struct ObjData {
-  std::vector<Vec3> vertices;
-  std::vector<std::array<uint32_t, 3>> triangles;
-  std::vector<uint32_t> triangleMaterial;
+  HugeVector<Vec3> vertices;  // the large arrays on whole huge pages (vox/core/huge_pages.h)
+  HugeVector<std::array<uint32_t, 3>> triangles;
+  HugeVector<uint32_t> triangleMaterial;
   std::vector<std::string> materialNames;  // `usemtl` names, in order of first use
   std::vector<long long> materialLines;    // the line of each name's first `usemtl`
   std::vector<ObjLibrary> libraries;       // every `mtllib` file name, in file order

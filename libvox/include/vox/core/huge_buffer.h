@@ -35,7 +35,7 @@ class HugeBuffer {
 
   char* data_ = nullptr;
   size_t size_ = 0;
-  size_t mapped_ = 0;  // bytes mapped at data_, or 0 when data_ came from new[]
+  size_t mapped_ = 0;  // the bytes asked of mapHugePages for data_, or 0 when data_ came from new[]
 };
 
 }  // namespace vox

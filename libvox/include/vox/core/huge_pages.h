@@ -1,10 +1,13 @@
 // Large arrays on transparent huge pages. With the kernel's THP setting at "madvise" (Debian's default), anonymous
 // memory gets 2 MiB pages only where the process asks; the voxelizer's reference arrays at 1024^3 (tens of MB each,
 // written once front to back) otherwise spend a fifth of their time in 4 KiB page faults (docs/voxelize-speed.md).
+// On the virtual machines we run on a 4 KiB page fault costs 12-16 us: 2.5 MB of fresh 4 KiB pages cost as much
+// time as parsing them from an OBJ text.
 #pragma once
 
 #include <algorithm>
 #include <cstddef>
+#include <new>
 #include <vector>
 
 namespace vox {
@@ -14,9 +17,54 @@ namespace vox {
 // does nothing (a single huge page would be mostly empty).
 void adviseHugePages(const void* data, size_t bytes);
 
-// v.reserve(n), then adviseHugePages on the capacity not yet written (the part the kernel has not faulted in).
+// Allocations of at least this many bytes are whole 2 MiB-aligned huge pages (HugePageAllocator): one fault that
+// zeroes 2 MiB costs less than the 64 faults of 256 KiB on 4 KiB pages, so the memory left over is worth it.
+constexpr size_t kHugePageBytes = size_t{2} << 20;
+constexpr size_t kHugeAllocationMin = size_t{256} << 10;
+
+// `bytes` (at least kHugeAllocationMin) on their own 2 MiB-aligned mapping, rounded up to whole huge pages and
+// advised as such; not zeroed (the kernel hands out zero pages). Throws std::bad_alloc. Freed by releaseHugePages
+// with the same `bytes`.
+void* mapHugePages(size_t bytes);
+void releaseHugePages(void* data, size_t bytes);
+
+// A std::allocator whose large blocks (kHugeAllocationMin and more) are whole huge pages: malloc places a large
+// block at an address it chooses (and glibc's moving mmap threshold may put it in the heap), so madvise on it
+// covers only the 2 MiB pages inside, leaving up to 4 MiB of it to 4 KiB faults. Smaller blocks come from operator
+// new. Stateless: any two compare equal.
 template <typename T>
-void reserveOnHugePages(std::vector<T>& v, size_t n) {
+struct HugePageAllocator {
+  using value_type = T;
+  HugePageAllocator() = default;
+  template <typename U>
+  HugePageAllocator(const HugePageAllocator<U>&) noexcept {}  // NOLINT: converting, as std::allocator's
+
+  T* allocate(size_t n) {
+    if (n > size_t(-1) / sizeof(T)) throw std::bad_array_new_length();
+    const size_t bytes = n * sizeof(T);
+    if (bytes < kHugeAllocationMin) return std::allocator<T>().allocate(n);
+    return static_cast<T*>(mapHugePages(bytes));
+  }
+  void deallocate(T* p, size_t n) noexcept {
+    const size_t bytes = n * sizeof(T);
+    if (bytes < kHugeAllocationMin)
+      std::allocator<T>().deallocate(p, n);
+    else
+      releaseHugePages(p, bytes);
+  }
+  template <typename U>
+  bool operator==(const HugePageAllocator<U>&) const noexcept {
+    return true;
+  }
+};
+
+// A vector whose storage, once large, is whole huge pages.
+template <typename T>
+using HugeVector = std::vector<T, HugePageAllocator<T>>;
+
+// v.reserve(n), then adviseHugePages on the capacity not yet written (the part the kernel has not faulted in).
+template <typename T, typename A>
+void reserveOnHugePages(std::vector<T, A>& v, size_t n) {
   v.reserve(n);
   adviseHugePages(v.data() + v.size(), (v.capacity() - v.size()) * sizeof(T));
 }
@@ -24,8 +72,8 @@ void reserveOnHugePages(std::vector<T>& v, size_t n) {
 // Before a push_back onto an array that may grow large: when it is full, doubles its capacity on huge pages, so
 // that a reader growing its arrays one element at a time (an OBJ's vertices and faces) does not fault them in
 // 4 KiB at a time.
-template <typename T>
-void growOnHugePages(std::vector<T>& v) {
+template <typename T, typename A>
+void growOnHugePages(std::vector<T, A>& v) {
   if (v.size() == v.capacity()) reserveOnHugePages(v, std::max<size_t>(v.capacity() * 2, 1024));
 }
 

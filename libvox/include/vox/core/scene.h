@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "vox/core/huge_pages.h"
 #include "vox/core/math.h"
 #include "vox/core/solid_texture.h"
 #include "vox/core/texture.h"
@@ -85,7 +86,7 @@ struct Light {
 struct Scene {
   std::vector<Material> materials;          // never empty after import: importers add a default white material
   std::vector<SolidTexture> solidTextures;  // referenced by Material::solidTexture
-  std::vector<Triangle> triangles;
+  HugeVector<Triangle> triangles;           // large ones on whole huge pages (a mesh is read into it once)
   std::vector<Sphere> spheres;
   std::vector<Plane> planes;
   std::vector<Texture> textures;                     // referenced by Material::diffuseTexture

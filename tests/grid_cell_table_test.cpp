@@ -167,8 +167,8 @@ TEST(GridCellTable, MalformedTablesAreRefusedAtTheirByte) {
     Grid grid;
     grid.dims = {4, 4, 4};
     getCellTable(r, grid, 10);
-    EXPECT_EQ(grid.cellKeys, (std::vector<uint64_t>{5, 7}));
-    EXPECT_EQ(grid.primIds, (std::vector<uint32_t>{2, 3, 4}));
+    EXPECT_EQ(grid.cellKeys, (HugeVector<uint64_t>{5, 7}));
+    EXPECT_EQ(grid.primIds, (HugeVector<uint32_t>{2, 3, 4}));
   }
   expectRefused(table(2, 3, {5, 0, 4, 58, 1, 2, 0}), "cell key outside the grid");       // 5 + 1 + 58 = 64
   expectRefused(table(1, 1, {64, 0, 0}), "cell key outside the grid");                   // past the last cell

@@ -31,7 +31,7 @@ Grid makeGrid(const std::array<uint32_t, 3>& dims, const CellSet& cells, const C
   std::vector<uint64_t> keys;
   for (const Cell& c : cells) keys.push_back(cellKey(dims, c[0], c[1], c[2]));
   std::sort(keys.begin(), keys.end());
-  g.cellKeys = keys;
+  g.cellKeys.assign(keys.begin(), keys.end());
   g.cellStart = {0};
   for (size_t i = 0; i < keys.size(); ++i) {
     for (uint32_t p = 0; p <= i % 3; ++p) g.primIds.push_back(p);

@@ -71,7 +71,7 @@ void checkSolidRuns(const std::vector<CellRun>& runs, uint64_t cellCount, const 
   }
 }
 
-void checkSolidRunsMissCells(const std::vector<uint64_t>& sortedKeys, const std::vector<CellRun>& runs,
+void checkSolidRunsMissCells(std::span<const uint64_t> sortedKeys, const std::vector<CellRun>& runs,
                              const std::string& what) {
   size_t c = 0;
   for (size_t r = 0; r < runs.size() && c < sortedKeys.size(); ++r) {

@@ -252,7 +252,7 @@ void writeModels(std::ostream& out, std::string& buf, const Grid& plan, const Ti
     slab.clear();
   };
   // The palette index of each occupied cell of the current piece, and the cell the rows have reached.
-  const std::vector<uint64_t>* keys = nullptr;
+  const HugeVector<uint64_t>* keys = nullptr;
   std::vector<uint8_t> cellIndex;
   size_t a = 0;
   const auto startPiece = [&](const Grid& piece, std::span<const Rgb8> colors) {

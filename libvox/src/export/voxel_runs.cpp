@@ -37,7 +37,7 @@ void forEachVoxelInterval(const Grid& grid, const std::function<void(uint64_t fi
     if (n == 0 || n > kMaxDim) fail<InputError>("grid: dimension ", n, " outside 1..2^21");
   const uint64_t cells = grid.cellCount();
   checkSolidRuns(grid.solidRuns, cells, "grid");
-  const std::vector<uint64_t>& keys = grid.cellKeys;
+  const HugeVector<uint64_t>& keys = grid.cellKeys;
   size_t a = 0, b = 0;
   bool open = false;
   uint64_t first = 0, end = 0;  // the run being grown, [first, end)

@@ -40,8 +40,8 @@ class ByteWriter {
     put(uint32_t(s.size()));
     putBytes(s);
   }
-  template <typename T>
-  void putArray(const std::vector<T>& values) {
+  template <typename T, typename A>
+  void putArray(const std::vector<T, A>& values) {
     static_assert(std::is_trivially_copyable_v<T>);
     put(uint64_t(values.size()));
     putBytes({reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T)});
@@ -114,10 +114,10 @@ class ByteReader {
       corrupt(std::string(what) + " count " + std::to_string(n) + " exceeds the file");
     return n;
   }
-  template <typename T>
-  std::vector<T> getArray(const char* what) {
+  template <typename T, typename Array = std::vector<T>>
+  Array getArray(const char* what) {
     const uint64_t n = getCount(sizeof(T), what);
-    std::vector<T> values(n);
+    Array values(n);
     if (n > 0) std::memcpy(values.data(), data_.data() + pos_, n * sizeof(T));  // data() may be null when empty
     pos_ += n * sizeof(T);
     return values;

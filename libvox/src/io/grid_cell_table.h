@@ -17,7 +17,7 @@ namespace vox {
 // many times as it streams the payload.
 struct EncodedCellTable {
   uint64_t occupied = 0, references = 0;
-  std::vector<char> bytes;  // on huge pages: see encodeCellTable
+  HugeVector<char> bytes;  // on huge pages: see encodeCellTable
 };
 EncodedCellTable encodeCellTable(const Grid& grid);
 

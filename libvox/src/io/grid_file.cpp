@@ -393,9 +393,9 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
   if (version >= 3) {
     getCellTable(r, grid, bounded);
   } else {
-    grid.cellKeys = r.getArray<uint64_t>("cell");
-    grid.cellStart = r.getArray<uint64_t>("cell start");
-    grid.primIds = r.getArray<uint32_t>("reference");
+    grid.cellKeys = r.getArray<uint64_t, HugeVector<uint64_t>>("cell");
+    grid.cellStart = r.getArray<uint64_t, HugeVector<uint64_t>>("cell start");
+    grid.primIds = r.getArray<uint32_t, HugeVector<uint32_t>>("reference");
   }
   const size_t outsideAt = r.position();
   grid.outsidePrims = r.getArray<uint32_t>("outside primitive");

@@ -210,8 +210,8 @@ void appendBrick(Grid& whole, const Grid& brick) {
 // place; otherwise (key, count) pairs are sorted, 16 bytes a cell more. Either is a direct sort: an indirect one
 // (an order, then a sorted copy) took twice the time (perf: most of a .vox export of a set at 2048^3).
 void sortKeysAndCounts(Grid& grid) {
-  std::vector<uint64_t>& keys = grid.cellKeys;
-  std::vector<uint64_t>& start = grid.cellStart;
+  HugeVector<uint64_t>& keys = grid.cellKeys;
+  HugeVector<uint64_t>& start = grid.cellStart;
   const size_t n = keys.size();
   const int countBits = 64 - std::max(1, int(std::bit_width(grid.cellCount() - 1)));
   uint64_t most = 0;
@@ -305,7 +305,7 @@ void forEachGridSetLayer(const std::string& setPath, const GridSetManifest& m, c
       Grid brick = readBrick(setPath, m, i, sceneFile.scene.boundedCount());
       if (cells == LayerCells::KeysOnly) brick.cellStart = {0};
       if (cells == LayerCells::KeysOnly || cells == LayerCells::KeysAndCounts)
-        std::vector<uint32_t>().swap(brick.primIds);
+        HugeVector<uint32_t>().swap(brick.primIds);
       appendBrick(layer, brick);
     }
     if (layer.cellKeys.size() > UINT32_MAX) fail<LimitError>(setPath, ": a layer of bricks holds more than 2^32 cells");

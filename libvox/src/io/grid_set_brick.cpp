@@ -95,9 +95,9 @@ Grid decodeBrickFile(const std::string& bytes, const std::string& name, const Gr
   if (index != entry.index) fail<InputError>(name, ": holds another brick than its manifest lists there");
   g.method = set.method;
   const size_t cellsAt = r.position();
-  g.cellKeys = r.getArray<uint64_t>("cell");
-  g.cellStart = r.getArray<uint64_t>("cell start");
-  g.primIds = r.getArray<uint32_t>("reference");
+  g.cellKeys = r.getArray<uint64_t, HugeVector<uint64_t>>("cell");
+  g.cellStart = r.getArray<uint64_t, HugeVector<uint64_t>>("cell start");
+  g.primIds = r.getArray<uint32_t, HugeVector<uint32_t>>("reference");
   const size_t runsAt = r.position();
   g.solidRuns = r.getArray<CellRun>("solid run");
   if (!r.atEnd()) r.corrupt("trailing bytes after the solid runs");

@@ -284,7 +284,7 @@ namespace {
 
 // One thread's references (packed key << primBits | id when key and id fit 64 bits, else pairs) and counters.
 struct Local {
-  std::vector<uint64_t> packedRefs;
+  HugeVector<uint64_t> packedRefs;
   std::vector<std::pair<uint64_t, uint32_t>> pairRefs;
   uint64_t tested = 0, fallbacks = 0, degenerate = 0;
 };
@@ -352,7 +352,7 @@ VoxelizeStats gatherReferences(tbb::enumerable_thread_specific<Local>& locals, b
     std::vector<std::span<const uint64_t>> parts;
     for (auto& l : locals) parts.emplace_back(l.packedRefs);
     const auto [sorted, n] = radixSortParts(parts, primBits + keyBits);
-    for (auto& l : locals) std::vector<uint64_t>().swap(l.packedRefs);
+    for (auto& l : locals) HugeVector<uint64_t>().swap(l.packedRefs);
     gatherSorted(sorted.get(), n, primBits, grid);
     return local;
   }

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "vox/core/huge_pages.h"
 #include "vox/core/math.h"
 
 namespace vox {
@@ -33,9 +34,9 @@ struct Grid {
   Box bounds;
   std::array<uint32_t, 3> dims{1, 1, 1};
   OverlapMethod method = OverlapMethod::Exact;
-  std::vector<uint64_t> cellKeys;
-  std::vector<uint64_t> cellStart{0};
-  std::vector<uint32_t> primIds;
+  HugeVector<uint64_t> cellKeys;  // large ones on whole huge pages (vox/core/huge_pages.h)
+  HugeVector<uint64_t> cellStart{0};
+  HugeVector<uint32_t> primIds;
   // Bounded primitives that stick out of user-given bounds: tracing tests them for every ray, like planes.
   std::vector<uint32_t> outsidePrims;
   // Cells inside the surface (--fill): sorted, disjoint, non-adjacent runs of keys. They hold no primitive; a cell
@@ -82,7 +83,7 @@ void checkSolidRuns(const std::vector<CellRun>& runs, uint64_t cellCount, const 
 // Throws InputError (prefixed by `what`) when a solid run covers an occupied cell: a cell is occupied or solid,
 // never both (counting it twice would make vox-info and the exports disagree). `sortedKeys` ascending, `runs` as
 // checkSolidRuns accepts them. O(cells + runs).
-void checkSolidRunsMissCells(const std::vector<uint64_t>& sortedKeys, const std::vector<CellRun>& runs,
+void checkSolidRunsMissCells(std::span<const uint64_t> sortedKeys, const std::vector<CellRun>& runs,
                              const std::string& what);
 
 // Smallest index range [first, last] of cells on `axis` whose closed boxes meet [lo, hi] (clamped to the grid);

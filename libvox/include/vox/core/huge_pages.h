@@ -7,7 +7,9 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <memory>
 #include <new>
+#include <type_traits>
 #include <vector>
 
 namespace vox {
@@ -61,6 +63,21 @@ struct HugePageAllocator {
 // A vector whose storage, once large, is whole huge pages.
 template <typename T>
 using HugeVector = std::vector<T, HugePageAllocator<T>>;
+
+// n elements of a trivial type, not initialised (a sort's buffers, written whole before they are read), from
+// HugePageAllocator.
+template <typename T>
+struct HugeArrayDeleter {
+  size_t n = 0;
+  void operator()(T* p) const noexcept { HugePageAllocator<T>().deallocate(p, n); }
+};
+template <typename T>
+using HugeArray = std::unique_ptr<T[], HugeArrayDeleter<T>>;
+template <typename T>
+HugeArray<T> makeHugeArray(size_t n) {
+  static_assert(std::is_trivial_v<T>);
+  return HugeArray<T>(HugePageAllocator<T>().allocate(n), HugeArrayDeleter<T>{n});
+}
 
 // v.reserve(n), then adviseHugePages on the capacity not yet written (the part the kernel has not faulted in).
 template <typename T, typename A>

@@ -806,6 +806,84 @@ TEST(ImportPly, SmallAsciiAndTruncated) {
   expectInputError([&] { loadScene(notPly); }, {"junk.ply"});
 }
 
+// ASCII bodies of 1 MiB and more are read in chunks of lines on all threads when every line holds one element
+// (import_ply.cpp, readAsciiLines); anything else is read on one thread. Both readings give the same scene, bit for
+// bit, and the same first error.
+TEST(ImportPly, LargeAsciiReadInLinesEqualsTheOneThreadReading) {
+  TempDir dir;
+  constexpr int kVertices = 40000;
+  constexpr int kFaces = 80000;
+  std::mt19937_64 random(16);
+  std::uniform_real_distribution<double> coordinate(-1e3, 1e3);
+  std::vector<std::string> vertexLines, faceLines;
+  std::vector<double> written;
+  char line[160];
+  for (int i = 0; i < kVertices; ++i) {
+    const double x = coordinate(random), y = coordinate(random), z = coordinate(random);
+    written.insert(written.end(), {x, y, z});
+    std::snprintf(line, sizeof line, "%.17g %.17g %.17g 0.5", x, y, z);
+    vertexLines.push_back(line);
+  }
+  for (int f = 0; f < kFaces; ++f) {
+    std::snprintf(line, sizeof line, "3 %d %d %d", f % kVertices, (f * 7 + 1) % kVertices, (f * 13 + 2) % kVertices);
+    faceLines.push_back(line);
+  }
+  const std::string header = "ply\nformat ascii 1.0\nelement vertex " + std::to_string(kVertices) +
+                             "\nproperty double x\nproperty double y\nproperty double z\nproperty float c\n"
+                             "element face " +
+                             std::to_string(kFaces) +
+                             "\nproperty list uchar int vertex_indices\nend_header\n";  // 10 lines
+  auto text = [&](const std::vector<std::string>& v, const std::vector<std::string>& f, const std::string& sep) {
+    std::string t = header;
+    for (const auto& l : v) t += l + sep;
+    for (const auto& l : f) t += l + sep;
+    return t;
+  };
+  const Scene lines = loadScene(dir.write("lines.ply", text(vertexLines, faceLines, "\n")));
+  ASSERT_EQ(lines.triangles.size(), size_t(kFaces));
+  for (int f = 0; f < kFaces; ++f) {
+    const int corner[3] = {f % kVertices, (f * 7 + 1) % kVertices, (f * 13 + 2) % kVertices};
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < 3; ++a)
+        ASSERT_EQ(bitsOf(lines.triangles[size_t(f)].v[k][a]), bitsOf(written[size_t(3 * corner[k] + a)])) << f;
+  }
+  auto expectSameScene = [&](const Scene& other, const char* what) {
+    ASSERT_EQ(other.triangles.size(), lines.triangles.size()) << what;
+    EXPECT_EQ(std::memcmp(other.triangles.data(), lines.triangles.data(), lines.triangles.size() * sizeof(Triangle)), 0)
+        << what;
+  };
+  // CRLF line ends, and white space after the last element: read in lines as well, the same scene.
+  expectSameScene(loadScene(dir.write("crlf.ply", text(vertexLines, faceLines, " \r\n") + "\n \n")), "CRLF");
+  // Two vertices on one line, and a blank line among the faces: one thread, the same scene.
+  std::vector<std::string> joined = vertexLines;
+  joined[kVertices - 2] += " " + joined[kVertices - 1];
+  joined.pop_back();
+  expectSameScene(loadScene(dir.write("joined.ply", text(joined, faceLines, "\n"))), "two vertices on a line");
+  std::vector<std::string> blank = faceLines;
+  blank[kFaces / 2] = "\n" + blank[kFaces / 2];
+  expectSameScene(loadScene(dir.write("blank.ply", text(vertexLines, blank, "\n"))), "a blank line");
+  // A quad: one thread, its two triangles in place.
+  std::vector<std::string> quad = faceLines;
+  quad[kFaces - 1] = "4 0 1 2 3";
+  EXPECT_EQ(loadScene(dir.write("quad.ply", text(vertexLines, quad, "\n"))).triangles.size(), size_t(kFaces + 1));
+  // Errors late in the file name their line, as on one thread (vertex i is on line 11 + i).
+  std::vector<std::string> bad = vertexLines;
+  bad[kVertices - 5] = "1 nan 0 0.5";
+  const std::string badPath = dir.write("bad.ply", text(bad, faceLines, "\n"));
+  expectInputError([&] { loadScene(badPath); }, {"bad.ply:" + std::to_string(11 + kVertices - 5) + ": vertex " +
+                                                 std::to_string(kVertices - 5) + ": bad number 'nan'"});
+  std::vector<std::string> cut = faceLines;
+  cut.resize(kFaces - 10);
+  const std::string cutPath = dir.write("cut.ply", text(vertexLines, cut, "\n"));
+  expectInputError([&] { loadScene(cutPath); }, {"cut.ply", "ends inside face " + std::to_string(kFaces - 10)});
+  std::vector<std::string> range = faceLines;
+  range[kFaces - 3] = "3 0 1 " + std::to_string(kVertices);
+  const std::string rangePath = dir.write("range.ply", text(vertexLines, range, "\n"));
+  expectInputError([&] { loadScene(rangePath); },
+                   {"range.ply:" + std::to_string(11 + kVertices + kFaces - 3) + ": face " +
+                    std::to_string(kFaces - 3) + ": vertex index " + std::to_string(kVertices) + " out of range"});
+}
+
 TEST(ImportDispatch, ExtensionIsCaseInsensitiveAndUnknownIsRefused) {
   TempDir dir;
   fs::copy_file(course("cube.obj"), dir.file("CUBE.OBJ"));

@@ -18,6 +18,9 @@ from conftest import BUNNY_PLY, SCENES, assert_same_grid, read_ascii_ply
 INTERRUPT = textwrap.dedent("""
     import os, signal, sys, threading, time
     import libvox
+    # Python turns SIGINT into KeyboardInterrupt only when its parent left SIGINT alone; a job started in the
+    # background by a non-interactive shell (as a CI runner may start us) inherits it ignored.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     what = sys.argv[1]
     # Reading a scene file and building the trace structure (the first ray call on a grid) are not interruptible:
     # done before the clock starts, so that what is measured is the voxelization's and the render's own loops.

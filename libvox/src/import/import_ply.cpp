@@ -15,7 +15,12 @@
 // - faces: the `vertex_indices` (or `vertex_index`) list, fan-triangulated; an index outside the vertices is an
 //   error; repeated indices give degenerate triangles, kept as DESIGN.md says; faces with fewer than 3 vertices
 //   are skipped with one warning. Other elements and properties are checked and skipped.
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cfloat>
 #include <charconv>
@@ -212,6 +217,15 @@ class AsciiCursor {
  public:
   AsciiCursor(std::string_view data, const PlyHeader& h, const std::string& path)
       : data_(data), pos_(h.bodyStart), line_(h.lines + 1), path_(path) {}
+  // Over one line of the body (line number `line` of the file): the element of that line, read by itself.
+  AsciiCursor(std::string_view line, long long number, const std::string& path)
+      : data_(line), pos_(0), line_(number), path_(path) {}
+
+  // Whether nothing but white space is left.
+  bool atEnd() {
+    while (pos_ < data_.size() && isSpace(data_[pos_])) ++pos_;
+    return pos_ == data_.size();
+  }
 
   void at(const PlyElement& e, long long i) {
     element_ = &e;
@@ -341,22 +355,39 @@ class BinaryCursor {
   size_t start_ = 0;
 };
 
-// Reads one face's index list and appends its fan of triangles.
+// Reads one face's index list into `polygon`.
 template <typename Cursor>
-void readFace(Cursor& in, const PlyProperty& p, long long n, size_t vertexCount, std::vector<uint32_t>& polygon,
-              PlyMesh& out) {
-  polygon.clear();
+void readFace(Cursor& in, const PlyProperty& p, long long n, size_t vertexCount, std::vector<uint32_t>& polygon) {
   for (long long k = 0; k < n; ++k) {
     const long long v = in.integer(p.valueType);
     if (v < 0 || static_cast<unsigned long long>(v) >= vertexCount)
       in.failHere("vertex index ", v, " out of range (", vertexCount, " vertices)");
     polygon.push_back(static_cast<uint32_t>(v));
   }
-  if (polygon.size() < 3) {
-    ++out.shortFaces;
-    return;
+}
+
+// Reads one instance of element `e` (the cursor placed at it): its coordinates into xyz, its index list (when it has
+// one) into `polygon`, every other value checked and skipped.
+template <typename Cursor>
+void readInstance(Cursor& in, const PlyElement& e, size_t vertexCount, double xyz[3], std::vector<uint32_t>& polygon) {
+  polygon.clear();
+  for (const PlyProperty& p : e.properties) {
+    if (!p.list) {
+      const double v = in.real(p.valueType);
+      if (p.role == Role::Skip) continue;
+      if (!std::isfinite(v)) in.failHere("coordinate ", p.name, " is NaN or infinite");
+      xyz[static_cast<int>(p.role) - static_cast<int>(Role::X)] = v;
+      continue;
+    }
+    const long long n = in.integer(p.countType);
+    const size_t valueBytes = typeSize(p.valueType);
+    if (n < 0 || static_cast<unsigned long long>(n) > in.maxListLength(valueBytes)) in.failHere("bad list length ", n);
+    if (p.role == Role::Indices) {
+      readFace(in, p, n, vertexCount, polygon);
+    } else {
+      for (long long k = 0; k < n; ++k) in.real(p.valueType);
+    }
   }
-  for (size_t k = 1; k + 1 < polygon.size(); ++k) out.triangles.push_back({polygon[0], polygon[k], polygon[k + 1]});
 }
 
 template <typename Cursor>
@@ -367,25 +398,14 @@ void readElement(Cursor& in, const PlyElement& e, size_t vertexCount, PlyMesh& o
   for (long long i = 0; i < e.count; ++i) {
     in.at(e, i);
     double xyz[3] = {0, 0, 0};
-    for (const PlyProperty& p : e.properties) {
-      if (!p.list) {
-        const double v = in.real(p.valueType);
-        if (p.role == Role::Skip) continue;
-        if (!std::isfinite(v)) in.failHere("coordinate ", p.name, " is NaN or infinite");
-        xyz[static_cast<int>(p.role) - static_cast<int>(Role::X)] = v;
-        continue;
-      }
-      const long long n = in.integer(p.countType);
-      const size_t valueBytes = typeSize(p.valueType);
-      if (n < 0 || static_cast<unsigned long long>(n) > in.maxListLength(valueBytes))
-        in.failHere("bad list length ", n);
-      if (p.role == Role::Indices) {
-        readFace(in, p, n, vertexCount, polygon, out);
-      } else {
-        for (long long k = 0; k < n; ++k) in.real(p.valueType);
-      }
-    }
+    readInstance(in, e, vertexCount, xyz, polygon);
     if (isVertex) out.vertices.push_back({xyz[0], xyz[1], xyz[2]});
+    if (polygon.empty()) continue;
+    if (polygon.size() < 3) {
+      ++out.shortFaces;
+      continue;
+    }
+    for (size_t k = 1; k + 1 < polygon.size(); ++k) out.triangles.push_back({polygon[0], polygon[k], polygon[k + 1]});
   }
 }
 
@@ -402,6 +422,86 @@ PlyMesh readBody(Cursor in, const PlyHeader& h) {
   return out;
 }
 
+// ASCII bodies of 1 MiB and more, read on all threads: every writer we know puts one element on a line, so line k
+// of the body is a known instance of a known element, and chunks of lines can be read side by side, each writing its
+// vertices and triangles in place. This is tried only when it cannot change the result: every line must hold exactly
+// its element, every face exactly 3 indices, and the lines after the last element nothing. Anything else (an error,
+// a polygon, an element over two lines) returns nullopt, and the file is read again on one thread, which reports
+// the file's first error as always.
+std::optional<PlyMesh> readAsciiLines(std::string_view data, const PlyHeader& h, const std::string& path) {
+  constexpr size_t kChunkBytes = size_t{1} << 19;
+  const std::string_view body = data.substr(h.bodyStart);
+  // On one thread the counting pass only adds time (10.8-11.1 ms against 9.1-9.7 for the bunny's PLY).
+  const size_t threads = std::min(size_t(tbb::this_task_arena::max_concurrency()),
+                                  tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+  if (body.size() < 2 * kChunkBytes || threads < 2) return std::nullopt;
+  // Each element with properties takes count lines, in header order; lineEnd[e] is the body line after element e.
+  std::vector<long long> lineEnd;
+  long long lines = 0;
+  size_t vertexCount = 0, faceCount = 0;
+  int vertexElements = 0, faceElements = 0;
+  for (const PlyElement& e : h.elements) {
+    if (!e.properties.empty()) lines += e.count;
+    lineEnd.push_back(lines);
+    if (e.name == "vertex") vertexCount = size_t(e.count), ++vertexElements;
+    if (e.name == "face") faceCount = size_t(e.count), ++faceElements;
+  }
+  if (vertexElements > 1 || faceElements > 1) return std::nullopt;  // read one after the other, appended
+  std::vector<std::string_view> chunks;
+  for (size_t begin = 0; begin < body.size();) {
+    size_t end = body.size();
+    if (body.size() - begin >= 2 * kChunkBytes) {
+      const size_t eol = body.find('\n', begin + kChunkBytes - 1);
+      if (eol != std::string_view::npos) end = eol + 1;
+    }
+    chunks.push_back(body.substr(begin, end - begin));
+    begin = end;
+  }
+  std::vector<long long> linesBefore(chunks.size() + 1, 0);
+  tbb::parallel_for(size_t(0), chunks.size(),
+                    [&](size_t k) { linesBefore[k + 1] = std::count(chunks[k].begin(), chunks[k].end(), '\n'); });
+  for (size_t k = 0; k < chunks.size(); ++k) linesBefore[k + 1] += linesBefore[k];
+  if (linesBefore.back() + (body.back() != '\n') < lines) return std::nullopt;  // too few lines: not one a line
+
+  PlyMesh out;
+  out.vertices.resize(vertexCount);
+  out.triangles.resize(faceCount);
+  std::atomic<bool> fits{true};
+  tbb::parallel_for(size_t(0), chunks.size(), [&](size_t k) {
+    try {
+      std::vector<uint32_t> polygon;
+      long long line = linesBefore[k];
+      size_t e = 0;
+      for (std::string_view rest = chunks[k]; !rest.empty() && fits.load(std::memory_order_relaxed); ++line) {
+        const size_t eol = rest.find('\n');
+        const std::string_view text = rest.substr(0, eol);
+        rest.remove_prefix(eol == std::string_view::npos ? rest.size() : eol + 1);
+        while (e < lineEnd.size() && lineEnd[e] <= line) ++e;
+        AsciiCursor in(text, h.lines + 1 + line, path);
+        if (e == lineEnd.size()) {  // past the last element: only white space may follow
+          if (!in.atEnd()) fits = false;
+          continue;
+        }
+        const PlyElement& element = h.elements[e];
+        const long long i = line - (e > 0 ? lineEnd[e - 1] : 0);
+        in.at(element, i);
+        double xyz[3] = {0, 0, 0};
+        readInstance(in, element, vertexCount, xyz, polygon);
+        if (!in.atEnd()) fits = false;
+        if (element.name == "vertex") out.vertices[size_t(i)] = {xyz[0], xyz[1], xyz[2]};
+        if (element.name == "face" && polygon.size() == 3)
+          out.triangles[size_t(i)] = {polygon[0], polygon[1], polygon[2]};
+        else if (element.name == "face" || !polygon.empty())
+          fits = false;
+      }
+    } catch (const InputError&) {
+      fits = false;
+    }
+  });
+  if (!fits) return std::nullopt;
+  return out;
+}
+
 }  // namespace
 
 Scene importPly(const std::string& path) {
@@ -410,8 +510,11 @@ Scene importPly(const std::string& path) {
   PlyHeader header = parseHeader(data, path);
   checkCounts(header, data.size() - header.bodyStart, path);
   assignRoles(header, path);
-  const PlyMesh mesh = header.format == "ascii" ? readBody(AsciiCursor(data, header, path), header)
-                                                : readBody(BinaryCursor(data, header, path), header);
+  std::optional<PlyMesh> lines;
+  if (header.format == "ascii") lines = readAsciiLines(data, header, path);
+  const PlyMesh mesh = lines                      ? std::move(*lines)
+                       : header.format == "ascii" ? readBody(AsciiCursor(data, header, path), header)
+                                                  : readBody(BinaryCursor(data, header, path), header);
 
   Scene scene;
   scene.materials.push_back(Material{"default"});

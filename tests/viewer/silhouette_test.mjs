@@ -1,7 +1,9 @@
 // With the camera set through the hash, the page's screenshot covers the pixels that `vox-trace --mode voxels`
 // covers with the same grid and camera (--eye --look-at --up --fov, DESIGN.md's camera convention): intersection over
 // union of the covered pixels at least 0.95, for the course's bunny at 40x40x33 (three views, one close), the Duck
-// with texture colours, and an empty grid (nothing covered in either). A pixel is covered when it differs from the
+// with texture colours, and an empty grid (nothing covered in either). Without a hash the page takes the file's own
+// camera, as vox-trace does without camera flags: a course orthographic and a perspective camera on pages twice as
+// wide as high, whose size or angle spans the longer side. A pixel is covered when it differs from the
 // scene's background. The page is shown as a user sees it, its panel hidden and the bounds' lines switched off.
 import { readFileSync } from 'node:fs';
 import { join } from 'node:path';
@@ -66,18 +68,28 @@ tool('vox-voxelize', join(source, 'scenes', 'bunny_1k.obj'), '-o', join(dir, 'em
   '5', '6', '6', '6', '--grid', '4', '4', '4', '--quiet');
 cases.push({ name: 'empty grid', grid: 'empty.vgrid', cam: { eye: [5.5, 5.5, 8], look: [5.5, 5.5, 5.5], fov: 45 }, empty: true });
 
+// The course's own cameras on wide pages.
+tool('vox-voxelize', join(source, 'scenes', 'scene5_02_spheres.txt'), '-o', join(dir, 'spheres.vgrid'), '--res', '40',
+  '--quiet');
+cases.push({ name: 'course orthographic camera, 400x200', grid: 'spheres.vgrid', fileCamera: true, size: [400, 200] });
+cases.push({ name: 'course perspective camera, 400x200', grid: 'bunny.vgrid', fileCamera: true, size: [400, 200] });
+
 const browser = await launch();
 for (const c of cases) {
   const grid = join(dir, c.grid);
+  const shape = c.size ?? size;
   const html = join(dir, `${c.grid}.${c.color ?? 'count'}.html`);
   tool('vox-export', grid, '-o', html, '--color', c.color ?? 'count', '--quiet');
   const traced = join(dir, `${c.grid}.png`);
-  const up = c.cam.up ?? [0, 1, 0];
-  tool('vox-trace', grid, '-o', traced, '--mode', 'voxels', '--size', String(size[0]), String(size[1]), '--eye',
-    ...c.cam.eye.map(String), '--look-at', ...c.cam.look.map(String), '--up', ...up.map(String), '--fov',
-    String(c.cam.fov), '--quiet');
+  const camera = c.fileCamera
+    ? []
+    : ['--eye', ...c.cam.eye.map(String), '--look-at', ...c.cam.look.map(String), '--up',
+      ...(c.cam.up ?? [0, 1, 0]).map(String), '--fov', String(c.cam.fov)];
+  tool('vox-trace', grid, '-o', traced, '--mode', 'voxels', '--size', String(shape[0]), String(shape[1]), ...camera,
+    '--quiet');
 
-  const { page, context, errors } = await openPage(browser, html, { hash: hashOf(c.cam), size });
+  const hash = c.fileCamera ? undefined : hashOf(c.cam);
+  const { page, context, errors } = await openPage(browser, html, { hash, size: shape });
   await page.evaluate(() => window.voxViewer.setPanelHidden(true));
   await page.evaluate(() => document.getElementById('vox-show-bounds').click());
   await settle(page);
@@ -90,7 +102,7 @@ for (const c of cases) {
   if (c.empty) {
     check(r.a === 0 && r.b === 0, `${c.name}: nothing covered (page ${r.a}, vox-trace ${r.b} pixels)`);
   } else {
-    const pixels = size[0] * size[1];
+    const pixels = shape[0] * shape[1];
     check(r.b > 0.02 * pixels, `${c.name}: vox-trace covers ${r.b} pixels (the view shows the grid)`);
     check(r.iou >= 0.95, `${c.name}: IoU ${r.iou.toFixed(4)} >= 0.95 (page ${r.a}, vox-trace ${r.b}, both ${r.both})`);
   }

@@ -1,18 +1,14 @@
-// Accel::cellBoxes (issue 27): for each cell of the block tables, a box of cells around it each of which holds only
-// primitives the cell itself holds, so that a walk that has tested the cell jumps to the box's exit instead of
-// stepping through its cells one by one. For an empty or solid cell that is a box of empty space (the merged empty
-// cells of the irregular grid of Pérard-Gayot, Kalojanov and Slusallek, 2017); for an occupied cell it is their
-// expansion over neighbours whose lists are subsets of its own. Kept as one box per cell instead of a merged cell
-// list, so that the walk stays the uniform walk between jumps.
+// Accel::cellBoxes (issue 27): for each empty or solid cell of the block tables, a box of cells around it that holds
+// no primitive, so that a walk entering the cell jumps to the box's exit instead of stepping through its cells one
+// by one (the merged empty cells of the irregular grid of Pérard-Gayot, Kalojanov and Slusallek, 2017, kept as one
+// box per cell instead of a merged cell list, so that the walk stays the uniform walk between jumps).
 //
 // Whether a layer of cells holds a primitive is answered in O(1) by a summed-volume table of the occupied cells, so
-// growing a box through empty space costs a few lookups per face; a layer with occupied cells is checked cell by cell
-// (only for an occupied cell's box). Reaches are capped (kBoxReachCap) to bound the build on grids with wide empty
-// spaces, which the block-level skipping (Accel::emptyShift) already crosses.
+// growing a box costs a few lookups per face; reaches are capped (kBoxReachCap) to bound the build on grids with
+// wide empty spaces, which the block-level skipping (Accel::emptyShift) already crosses.
 #include <algorithm>
 #include <array>
 #include <cstdint>
-#include <span>
 #include <vector>
 
 #include "vox/trace/accel.h"
@@ -54,31 +50,10 @@ class OccupiedCounts {
   std::vector<uint32_t> sum_;
 };
 
-// Does every occupied cell of the box [lo, hi] hold only primitives of `own` (ascending)? The layer's cells are
-// looked up one by one; an empty `own` (an empty or solid cell's box) admits no occupied cell.
-bool layerWithin(const Accel& accel, const OccupiedCounts& counts, const std::array<uint32_t, 3>& lo,
-                 const std::array<uint32_t, 3>& hi, std::span<const uint32_t> own) {
-  if (counts.box(lo, hi) == 0) return true;
-  if (own.empty()) return false;
-  for (uint32_t z = lo[2]; z <= hi[2]; ++z)
-    for (uint32_t y = lo[1]; y <= hi[1]; ++y)
-      for (uint32_t x = lo[0]; x <= hi[0]; ++x) {
-        const uint32_t c = accel.lookup(x, y, z);
-        if (c >= kSolidCell) continue;
-        const std::span<const uint32_t> prims = accel.cellPrims(c);
-        if (prims.size() > own.size()) return false;
-        for (const uint32_t id : prims)
-          if (!std::binary_search(own.begin(), own.end(), id)) return false;
-      }
-  return true;
-}
-
-// The box grown around cell c, whose primitives are `own` (ascending; empty for an empty or solid cell): each face
-// in turn (x-, x+, y-, y+, z-, z+) takes one more layer when the layer lies in the grid, holds only cells whose
-// primitives are all in `own` and the reach stays under the cap, until no face can grow.
-CellBox growBox(const Accel& accel, const OccupiedCounts& counts, const std::array<uint32_t, 3>& c,
-                std::span<const uint32_t> own) {
-  const std::array<uint32_t, 3> dims = accel.grid->dims;
+// The box grown around the empty cell c: each face in turn (x-, x+, y-, y+, z-, z+) takes one more layer when the
+// layer lies in the grid, holds no occupied cell and the reach stays under the cap, until no face can grow.
+CellBox growEmptyBox(const OccupiedCounts& counts, const std::array<uint32_t, 3>& dims,
+                     const std::array<uint32_t, 3>& c) {
   std::array<uint32_t, 3> lo = c, hi = c;
   for (bool grew = true; grew;) {
     grew = false;
@@ -89,7 +64,7 @@ CellBox growBox(const Accel& accel, const OccupiedCounts& counts, const std::arr
         continue;
       std::array<uint32_t, 3> layerLo = lo, layerHi = hi;
       layerLo[a] = layerHi[a] = up ? hi[a] + 1 : lo[a] - 1;
-      if (!layerWithin(accel, counts, layerLo, layerHi, own)) continue;
+      if (counts.box(layerLo, layerHi) != 0) continue;
       (up ? hi[a] : lo[a]) = layerLo[a];
       grew = true;
     }
@@ -112,7 +87,6 @@ void buildCellBoxes(Accel& accel) {
   accel.cellBoxes.assign(accel.cellSlots.size(), CellBox{{0, 0, 0}, {0, 0, 0}});
   const uint32_t s = accel.blockShift, side = 1u << s, m = side - 1;
   const auto& bd = accel.blockDims;
-  std::vector<uint32_t> own;
   for (uint32_t bz = 0; bz < bd[2]; ++bz)
     for (uint32_t by = 0; by < bd[1]; ++by)
       for (uint32_t bx = 0; bx < bd[0]; ++bx) {
@@ -123,17 +97,8 @@ void buildCellBoxes(Accel& accel) {
                                           (bz << s) | ((local >> (2 * s)) & m)};
           if (c[0] >= dims[0] || c[1] >= dims[1] || c[2] >= dims[2]) continue;
           const uint64_t slot = (uint64_t(b) << (3 * s)) + local;
-          const uint32_t cell = accel.cellSlots[slot];
-          if (cell < kSolidCell) {
-            // The cell's own list, ascending (grid files are checked for it; sorted again so that a grid built
-            // otherwise cannot make a box hold a primitive the cell lacks).
-            const std::span<const uint32_t> prims = accel.cellPrims(cell);
-            own.assign(prims.begin(), prims.end());
-            std::sort(own.begin(), own.end());
-            accel.cellBoxes[slot] = growBox(accel, counts, c, own);
-          } else {
-            accel.cellBoxes[slot] = growBox(accel, counts, c, {});
-          }
+          if (accel.cellSlots[slot] < kSolidCell) continue;  // occupied: tested where it is
+          accel.cellBoxes[slot] = growEmptyBox(counts, dims, c);
         }
       }
 }

@@ -342,50 +342,32 @@ inline bool walkCells(const Accel& accel, const Ray& ray, Hit& best, TraceStats&
   // Which side of a cell box lies ahead on each axis (a box reaching only backwards or sideways saves no step).
   const bool ahead[3] = {ray.direction.x > 0, ray.direction.y > 0, ray.direction.z > 0};
   const bool behind[3] = {ray.direction.x < 0, ray.direction.y < 0, ray.direction.z < 0};
-  bool inTested = false;
-  std::array<uint32_t, 3> testedLo{}, testedHi{};
   walker.walk([&](const WalkCell& cell) {
     ++st.cells;
     bool hit = false;
     const uint32_t i = cell.idx[0], j = cell.idx[1], k = cell.idx[2];
-    uint64_t slot = UINT64_MAX;
-    // A cell inside the box of the occupied cell the walk last jumped from holds only primitives tested there.
-    const bool tested = inTested && i >= testedLo[0] && i <= testedHi[0] && j >= testedLo[1] && j <= testedHi[1] &&
-                        k >= testedLo[2] && k <= testedHi[2];
     if (accel.blockShift == 0) {
       const uint32_t c = accel.lookupSlow(i, j, k);
       if (c < kSolidCell) hit = testCell<AnyHit>(accel, c, ray, fr, mailbox, best, st);
-    } else if (slot = accel.slotOf(i, j, k); slot != UINT64_MAX) {
+    } else if (const uint64_t slot = accel.slotOf(i, j, k); slot != UINT64_MAX) {
       const uint32_t c = accel.cellSlots[slot];
-      if (c < kSolidCell && !tested)
+      if (c < kSolidCell) {
         hit = direct ? testGroups<AnyHit>(accel, accel.floatCells.slots[slot], ray, *fr, mailbox, best, st)
                      : testCell<AnyHit>(accel, c, ray, fr, mailbox, best, st);
-    }
-    bool stop;
-    if (AnyHit) {
-      anyHit = hit;
-      stop = hit;
-    } else {
-      // A hit may lie beyond this cell (a primitive spanning cells): it is kept, and accepted only once the walk
-      // has passed every cell that could hold a nearer one.
-      stop = best.valid() && best.t + walker.hitSlack(best.t) < cell.tExit - cell.exitSlack;
-    }
-    // Every cell of the cell's box holds only primitives just tested (none for an empty cell): jump to its exit.
-    if (!stop && boxes && !cell.extra && slot != UINT64_MAX) {
-      const CellBox& b = accel.cellBoxes[slot];
-      if ((ahead[0] & (b.hi[0] != 0)) | (ahead[1] & (b.hi[1] != 0)) | (ahead[2] & (b.hi[2] != 0)) |
-          (behind[0] & (b.lo[0] != 0)) | (behind[1] & (b.lo[1] != 0)) | (behind[2] & (b.lo[2] != 0))) {
-        const std::array<uint32_t, 3> lo{i - b.lo[0], j - b.lo[1], k - b.lo[2]},
-            hi{i + b.hi[0], j + b.hi[1], k + b.hi[2]};
-        walker.jumpOver(lo, hi);
-        if (accel.cellSlots[slot] < kSolidCell && !tested) {
-          inTested = true;
-          testedLo = lo;
-          testedHi = hi;
-        }
+      } else if (boxes && !cell.extra) {
+        const CellBox& b = accel.cellBoxes[slot];
+        if ((ahead[0] & (b.hi[0] != 0)) | (ahead[1] & (b.hi[1] != 0)) | (ahead[2] & (b.hi[2] != 0)) |
+            (behind[0] & (b.lo[0] != 0)) | (behind[1] & (b.lo[1] != 0)) | (behind[2] & (b.lo[2] != 0)))
+          walker.jumpOver({i - b.lo[0], j - b.lo[1], k - b.lo[2]}, {i + b.hi[0], j + b.hi[1], k + b.hi[2]});
       }
     }
-    return stop;
+    if (AnyHit) {
+      anyHit = hit;
+      return hit;
+    }
+    // A hit may lie beyond this cell (a primitive spanning cells): it is kept, and accepted only once the walk
+    // has passed every cell that could hold a nearer one.
+    return best.valid() && best.t + walker.hitSlack(best.t) < cell.tExit - cell.exitSlack;
   });
   return anyHit;
 }

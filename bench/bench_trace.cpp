@@ -32,6 +32,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
+#include <exception>
 #include <functional>
 #include <memory>
 #include <string>
@@ -519,6 +520,20 @@ void benchIncoherent(const std::string& path, unsigned threads, uint32_t size, i
   std::printf("\n%s: %zu triangles, %s grid %ux%ux%u, %zu secondary rays per set\n", name, scene.triangles.size(),
               factor > 0 ? ("cells/triangle " + std::to_string(factor).substr(0, 4)).c_str() : "default", grid.dims[0],
               grid.dims[1], grid.dims[2], sets[0].rays.size());
+  // What the cell boxes cost on top of the uniform walk's structure (issue 27's build goal): their build alone, best
+  // of 3 on a copy of the uniform accel (one thread: buildCellBoxes is serial), and their bytes.
+  double boxSeconds = 1e300;
+  for (int r = 0; r < 3; ++r) {
+    vox::Accel copy = uniform;
+    const auto t0 = Clock::now();
+    vox::buildCellBoxes(copy);
+    boxSeconds = std::min(boxSeconds, std::chrono::duration<double>(Clock::now() - t0).count());
+  }
+  const double tableBytes = double(accel.blockSlot.size() + accel.cellSlots.size()) * sizeof(uint32_t) +
+                            double(accel.emptyShift.size()) +
+                            double(accel.floatCells.slots.size()) * sizeof(vox::FloatCells::Cell);
+  std::printf("  cell boxes: build %.1f ms, %.2f MB (the cell tables without them %.2f MB)\n", boxSeconds * 1e3,
+              double(accel.cellBoxes.size() * sizeof(vox::CellBox)) / 1e6, tableBytes / 1e6);
   std::printf("  %-11s %10s %10s %12s %12s %8s %8s %9s %9s %9s %s\n", "set", "query", "embree", "ours", "ours/embree",
               "(best)", "(cpu)", "same", "close t", "mismatch", "brute force (diff/checked), per ray");
   for (const RaySet& set : sets) {
@@ -579,6 +594,10 @@ void benchIncoherent(const std::string& path, unsigned threads, uint32_t size, i
         methods[0].median() / methods[4].median(), methods[0].median() / methods[5].median(),
         (unsigned long long)textbookDiff, methods[0].median() / methods[6].median(),
         double(uniformStats.cells) / uniformStats.rays, (unsigned long long)uniformDiff);
+    if (set.name == "ao")  // one ambient-occlusion ray per pixel of a 1024x1024 image at this set's rate
+      std::printf("  cell boxes' build: %.2f%% of a 1024x1024 image of one ao ray per pixel (%.3f s at this rate)\n",
+                  100 * boxSeconds / (1024.0 * 1024.0 / n * methods[1].median()),
+                  1024.0 * 1024.0 / n * methods[1].median());
     std::fflush(stdout);
   }
 }
@@ -606,7 +625,23 @@ int main(int argc, char** argv) {
       incoherent = true;
     else if (a == "--ours-only")
       oursOnly = true;
-    else
+    else if (a == "--help" || a == "-h") {
+      std::printf(
+          "bench_trace [SCENE...] [--threads N] [--size S] [--reps R] [--factor F]... [--incoherent [--ours-only]]\n"
+          "  Rays per second of our grid walk against Embree 3 on the same rays (docs/trace.md, docs/speed.md).\n"
+          "  Default scenes: the course's 40k bunny, the 69k Stanford bunny, SheenCloth (from VOX_SEED_DIR).\n"
+          "  --threads N     TBB threads (default 1)\n"
+          "  --size S        S x S primary rays (default 1024)\n"
+          "  --reps R        rounds taken in turns (default 7)\n"
+          "  --factor F      grids of F cells per triangle (repeatable; primary default 0.5 1 2 3, incoherent: the\n"
+          "                  default grid of vox-voxelize)\n"
+          "  --incoherent    secondary rays (reflection, hemisphere, ao, shadow) from the primary hits\n"
+          "  --ours-only     with --incoherent: time only our walk, check nothing (for profiling)\n");
+      return 0;
+    } else if (a.rfind("--", 0) == 0) {
+      std::fprintf(stderr, "bench_trace: unknown option %s (see --help)\n", a.c_str());
+      return 1;
+    } else
       scenes.push_back(a);
   }
   // Incoherent sets: the default grid unless factors are given.
@@ -628,11 +663,14 @@ int main(int argc, char** argv) {
     std::printf("threads: %u, image: %ux%u primary rays, best of %d rounds taken in turns\n", threads, size, size,
                 reps);
 
-  for (const std::string& path : scenes) {
-    if (incoherent)
-      for (double f : incoherentFactors) benchIncoherent(path, threads, size, reps, oursOnly, f);
-    else
-      benchPrimary(path, threads, size, reps, factors);
-  }
+  for (const std::string& path : scenes) try {
+      if (incoherent)
+        for (double f : incoherentFactors) benchIncoherent(path, threads, size, reps, oursOnly, f);
+      else
+        benchPrimary(path, threads, size, reps, factors);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "bench_trace: %s\n", e.what());
+      return 2;
+    }
   return 0;
 }

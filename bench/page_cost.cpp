@@ -61,12 +61,26 @@ int main(int argc, char** argv) {
   std::string path = std::string(VOX_SEED_DIR) + "/meshes/derived/sheencloth_115k.obj";
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--rounds" && i + 1 < argc)
+    if (a == "--rounds" && i + 1 < argc) {
       rounds = std::max(1, std::atoi(argv[++i]));
-    else
+    } else if (a == "--help" || a == "-h") {
+      std::printf(
+          "page_cost [--rounds N] [FILE]\n  Zeroing and reading FILE into fresh memory, 4 KiB pages against huge "
+          "pages (default: the SheenCloth OBJ).\n");
+      return 0;
+    } else if (a.rfind("--", 0) == 0) {
+      std::fprintf(stderr, "page_cost: unknown option %s (see --help)\n", a.c_str());
+      return 1;
+    } else {
       path = a;
+    }
   }
-  const size_t size = std::filesystem::file_size(path);
+  std::error_code error;
+  const size_t size = std::filesystem::file_size(path, error);
+  if (error) {
+    std::fprintf(stderr, "page_cost: %s: %s\n", path.c_str(), error.message().c_str());
+    return 2;
+  }
   std::printf("%zu bytes, %d rounds; medians in ms\n", size, rounds);
   std::vector<double> z4, r4, zh, rh, rb;
   for (int r = 0; r < rounds; ++r) {

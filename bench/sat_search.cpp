@@ -5,13 +5,24 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 
 #include "adversary.h"
 #include "vox/voxelize/overlap.h"
 
 int main(int argc, char** argv) {
   using namespace vox;
+  if (argc > 1 && (!std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h"))) {
+    std::printf(
+        "sat_search [PAIRS_PER_CASE]\n  Searches adversarial triangle-cell pairs for cells the sat test misses or "
+        "adds against the exact test (default 200000 pairs a case).\n");
+    return 0;
+  }
   const long pairs = argc > 1 ? std::atol(argv[1]) : 200000;
+  if (pairs <= 0) {
+    std::fprintf(stderr, "sat_search: PAIRS_PER_CASE must be a positive number, not %s\n", argv[1]);
+    return 1;
+  }
   bool found = false;
   Triangle best;
   Box bestBox;

@@ -10,8 +10,13 @@
 #include "tradeoff_core.h"
 
 int main(int argc, char** argv) {
-  if (argc < 2) {
-    std::fprintf(stderr, "usage: tradeoff OUT.csv [--small] [--threads N] [--size PIXELS] [--res R1,R2,...]\n");
+  const char* usage = "usage: tradeoff OUT.csv [--small] [--threads N] [--size PIXELS] [--res R1,R2,...]\n";
+  if (argc >= 2 && (!std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h"))) {
+    std::printf("%s  The speed-accuracy trade of the overlap methods and resolutions, one CSV row each.\n", usage);
+    return 0;
+  }
+  if (argc < 2 || argv[1][0] == '-') {
+    std::fprintf(stderr, "%s", usage);
     return 1;
   }
   bool small = false;
@@ -31,7 +36,18 @@ int main(int argc, char** argv) {
       options.resolutions.clear();
       std::stringstream list(argv[++i]);
       std::string item;
-      while (std::getline(list, item, ',')) options.resolutions.push_back(uint32_t(std::stoul(item)));
+      while (std::getline(list, item, ',')) {
+        char* end = nullptr;
+        const unsigned long r = std::strtoul(item.c_str(), &end, 10);
+        if (item.empty() || *end != '\0' || r > 65536) {
+          std::fprintf(stderr, "tradeoff: --res: not a resolution: '%s'\n", item.c_str());
+          return 1;
+        }
+        options.resolutions.push_back(uint32_t(r));
+      }
+    } else {
+      std::fprintf(stderr, "tradeoff: unknown option %s\n%s", argv[i], usage);
+      return 1;
     }
   }
   std::unique_ptr<tbb::global_control> limit;

@@ -6,6 +6,8 @@
 // Whether a layer of cells holds a primitive is answered in O(1) by a summed-volume table of the occupied cells, so
 // growing a box costs a few lookups per face; reaches are capped (kBoxReachCap) to bound the build on grids with
 // wide empty spaces, which the block-level skipping (Accel::emptyShift) already crosses.
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -87,7 +89,8 @@ void buildCellBoxes(Accel& accel) {
   accel.cellBoxes.assign(accel.cellSlots.size(), CellBox{{0, 0, 0}, {0, 0, 0}});
   const uint32_t s = accel.blockShift, side = 1u << s, m = side - 1;
   const auto& bd = accel.blockDims;
-  for (uint32_t bz = 0; bz < bd[2]; ++bz)
+  // Each block's cells get their boxes independently (the counts are only read): blocks in parallel.
+  tbb::parallel_for(uint32_t(0), bd[2], [&](uint32_t bz) {
     for (uint32_t by = 0; by < bd[1]; ++by)
       for (uint32_t bx = 0; bx < bd[0]; ++bx) {
         const uint32_t b = accel.blockSlot[bx + bd[0] * (by + uint64_t(bd[1]) * bz)];
@@ -101,6 +104,7 @@ void buildCellBoxes(Accel& accel) {
           accel.cellBoxes[slot] = growEmptyBox(counts, dims, c);
         }
       }
+  });
 }
 
 }  // namespace vox

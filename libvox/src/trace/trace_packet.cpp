@@ -339,14 +339,18 @@ void testCells(Packet& p, int64_t slice, const std::array<int64_t, 3>& ru, const
       ++p.st.cells;
       const uint32_t c = accel.lookup(idx[0], idx[1], idx[2]);
       if (c >= kSolidCell) continue;
-      for (uint32_t id : accel.cellPrims(c)) {
+      const uint64_t end = accel.grid->cellStart[c + 1];
+      for (uint64_t ref = accel.grid->cellStart[c]; ref < end; ++ref) {
+        const uint32_t id = accel.grid->primIds[ref];
         if (mailbox.seen(id)) {
           p.st.mailboxSkips += lanes.count;
           continue;
         }
         uint64_t hitBits = 0;
         if (id < accel.triangleCount) {
-          const TriangleData& tri = accel.triangles[id];
+          // The cell's own copy when there is one (Accel::cellTriangles): the same values, read from the run of
+          // memory after the cell's ids instead of a random place.
+          const TriangleData& tri = accel.cellTriangles.empty() ? accel.triangles[id] : accel.cellTriangles[ref];
           if (outsidePacket(tri, p.k, p.other, p.c0, p.bounds)) continue;
           p.st.tests += lanes.count;
           hitBits = triangleLanes(tri, lanes);

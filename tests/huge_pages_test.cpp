@@ -31,21 +31,6 @@ TEST(HugePages, ReserveKeepsContentsAndGrowsCapacity) {
   EXPECT_GE(v.capacity(), size_t{3} << 20);
 }
 
-TEST(HugePages, GrowDoublesOnlyWhenFull) {
-  std::vector<uint32_t> v;
-  growOnHugePages(v);
-  EXPECT_GE(v.capacity(), 1024u);
-  const size_t first = v.capacity();
-  v.push_back(7);
-  growOnHugePages(v);
-  EXPECT_EQ(v.capacity(), first);  // not full: untouched
-  v.resize(v.capacity(), 9);
-  growOnHugePages(v);
-  EXPECT_EQ(v.capacity(), 2 * first);
-  EXPECT_EQ(v[0], 7u);
-  EXPECT_EQ(v.back(), 9u);
-}
-
 TEST(HugePages, AdviceOnSmallOrNullRangesIsHarmless) {
   adviseHugePages(nullptr, size_t{1} << 30);
   const char small[16] = {};

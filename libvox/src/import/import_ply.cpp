@@ -35,6 +35,7 @@
 #include <vector>
 
 #include "import/obj_reader.h"
+#include "import/ply_header.h"
 #include "vox/core/error.h"
 #include "vox/core/huge_pages.h"
 #include "vox/import/import.h"
@@ -44,167 +45,6 @@ namespace {
 
 // Larger files are refused before they are read.
 constexpr size_t kMaxPlyFileBytes = size_t{8} << 30;
-
-enum class PlyType : uint8_t { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64 };
-
-std::optional<PlyType> plyType(std::string_view t) {
-  if (t == "char" || t == "int8") return PlyType::Int8;
-  if (t == "uchar" || t == "uint8") return PlyType::UInt8;
-  if (t == "short" || t == "int16") return PlyType::Int16;
-  if (t == "ushort" || t == "uint16") return PlyType::UInt16;
-  if (t == "int" || t == "int32") return PlyType::Int32;
-  if (t == "uint" || t == "uint32") return PlyType::UInt32;
-  if (t == "float" || t == "float32") return PlyType::Float32;
-  if (t == "double" || t == "float64") return PlyType::Float64;
-  return std::nullopt;
-}
-
-const char* typeName(PlyType t) {
-  static const char* kNames[] = {"char", "uchar", "short", "ushort", "int", "uint", "float", "double"};
-  return kNames[static_cast<int>(t)];
-}
-
-size_t typeSize(PlyType t) {
-  static const size_t kSizes[] = {1, 1, 2, 2, 4, 4, 4, 8};
-  return kSizes[static_cast<int>(t)];
-}
-
-bool isFloatType(PlyType t) { return t == PlyType::Float32 || t == PlyType::Float64; }
-
-// The range of an integer type.
-void integerRange(PlyType t, long long& lo, long long& hi) {
-  const int bits = 8 * static_cast<int>(typeSize(t));
-  const bool isSigned = t == PlyType::Int8 || t == PlyType::Int16 || t == PlyType::Int32;
-  lo = isSigned ? -(1LL << (bits - 1)) : 0;
-  hi = isSigned ? (1LL << (bits - 1)) - 1 : (1LL << bits) - 1;
-}
-
-// What a property means to us.
-enum class Role : uint8_t { Skip, X, Y, Z, Indices };
-
-struct PlyProperty {
-  std::string name;
-  bool list = false;
-  PlyType countType = PlyType::UInt8;  // list only
-  PlyType valueType = PlyType::Float32;
-  Role role = Role::Skip;
-};
-
-struct PlyElement {
-  std::string name;
-  long long count = 0;
-  std::vector<PlyProperty> properties;
-};
-
-struct PlyHeader {
-  std::string format;
-  std::vector<PlyElement> elements;
-  size_t bodyStart = 0;  // byte offset of the first byte after end_header's line
-  long long lines = 0;   // header lines, so that the body's first line is lines + 1
-};
-
-// Reads one header line's property into `e`; false when malformed.
-bool parseProperty(const std::vector<std::string>& w, PlyElement& e) {
-  PlyProperty p;
-  if (w.size() == 5 && w[1] == "list") {
-    const auto count = plyType(w[2]);
-    const auto value = plyType(w[3]);
-    if (!count || !value || isFloatType(*count)) return false;
-    p = {w[4], true, *count, *value, Role::Skip};
-  } else if (w.size() == 3) {
-    const auto value = plyType(w[1]);
-    if (!value) return false;
-    p = {w[2], false, PlyType::UInt8, *value, Role::Skip};
-  } else {
-    return false;
-  }
-  e.properties.push_back(p);
-  return true;
-}
-
-PlyHeader parseHeader(std::string_view data, const std::string& path) {
-  PlyHeader h;
-  size_t pos = 0;
-  for (;;) {
-    const size_t eol = data.find('\n', pos);
-    if (eol == std::string::npos) fail<InputError>(path, ": PLY header has no end_header line");
-    std::string line(data.substr(pos, eol - pos));
-    pos = eol + 1;
-    const long long lineNumber = ++h.lines;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    std::istringstream words(line);
-    std::vector<std::string> w;
-    for (std::string word; words >> word;) w.push_back(word);
-    auto bad = [&]() { fail<InputError>(path, ":", lineNumber, ": malformed PLY header line ", quotedWord(line)); };
-    if (lineNumber == 1) {
-      if (w.size() != 1 || w[0] != "ply") fail<InputError>(path, ": not a PLY file (first line is not 'ply')");
-    } else if (lineNumber == 2) {
-      if (w.size() != 3 || w[0] != "format" || w[2] != "1.0" ||
-          (w[1] != "ascii" && w[1] != "binary_little_endian" && w[1] != "binary_big_endian"))
-        bad();
-      h.format = w[1];
-    } else if (w.empty() || w[0] == "comment" || w[0] == "obj_info") {
-      continue;
-    } else if (w[0] == "end_header") {
-      break;
-    } else if (w[0] == "element") {
-      if (w.size() != 3) bad();
-      PlyElement e{w[1], -1, {}};
-      const auto [end, ec] = std::from_chars(w[2].data(), w[2].data() + w[2].size(), e.count);
-      if (ec != std::errc() || end != w[2].data() + w[2].size() || e.count < 0) bad();
-      h.elements.push_back(e);
-    } else if (w[0] == "property") {
-      if (h.elements.empty() || !parseProperty(w, h.elements.back())) bad();
-    } else {
-      bad();
-    }
-  }
-  h.bodyStart = pos;
-  return h;
-}
-
-// Marks the properties we read (x, y, z of `vertex`, the index list of `face`) and checks they are usable.
-void assignRoles(PlyHeader& h, const std::string& path) {
-  bool haveVertex = false;
-  for (PlyElement& e : h.elements) {
-    if (e.name == "vertex") {
-      if (haveVertex) fail<InputError>(path, ": PLY header has two vertex elements");
-      haveVertex = true;
-      int found = 0;
-      for (PlyProperty& p : e.properties) {
-        if (p.list || p.name.size() != 1 || p.name[0] < 'x' || p.name[0] > 'z') continue;
-        p.role = p.name == "x" ? Role::X : (p.name == "y" ? Role::Y : Role::Z);
-        ++found;
-      }
-      if (found != 3) fail<InputError>(path, ": PLY vertex element needs exactly one each of x, y, z properties");
-    } else if (e.name == "face") {
-      for (PlyProperty& p : e.properties)
-        if (p.list && (p.name == "vertex_indices" || p.name == "vertex_index")) {
-          if (isFloatType(p.valueType))
-            fail<InputError>(path, ": PLY face property '", p.name, "' holds ", typeName(p.valueType), " values");
-          p.role = Role::Indices;
-        }
-    }
-  }
-  if (!haveVertex) fail<InputError>(path, ": PLY header has no vertex element");
-}
-
-// Refuses any element count the body cannot hold, before anything is allocated or walked.
-void checkCounts(const PlyHeader& h, size_t bodyBytes, const std::string& path) {
-  const bool ascii = h.format == "ascii";
-  // An ASCII value takes at least a character and a separator (the last one may lack its separator).
-  unsigned long long budget = ascii ? bodyBytes + 1 : bodyBytes;
-  for (const PlyElement& e : h.elements) {
-    unsigned long long least = 0;  // bytes per element at least
-    for (const PlyProperty& p : e.properties) least += ascii ? 2 : typeSize(p.list ? p.countType : p.valueType);
-    least = std::max(least, 1ULL);
-    const auto count = static_cast<unsigned long long>(e.count);
-    if (count > budget / least)
-      fail<InputError>(path, ": PLY element ", quotedWord(e.name), " declares ", e.count, " items, more than the ",
-                       bodyBytes, " bytes after the header can hold (truncated?)");
-    budget -= count * least;
-  }
-}
 
 struct PlyMesh {
   HugeVector<Vec3> vertices;
@@ -237,7 +77,7 @@ class AsciiCursor {
 
   double real(PlyType t) {
     const std::string_view token = next();
-    if (!isFloatType(t)) return static_cast<double>(integer(t, token));
+    if (!isPlyFloat(t)) return static_cast<double>(integer(t, token));
     std::string_view s = token;
     if (!s.empty() && s[0] == '+') s.remove_prefix(1);
     double v = 0;
@@ -281,10 +121,10 @@ class AsciiCursor {
     const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
     const bool tooLarge = ec == std::errc::result_out_of_range;
     if (s.empty() || s[0] == '+' || end != s.data() + s.size() || (ec != std::errc() && !tooLarge))
-      failHere("bad ", typeName(t), " value ", quotedWord(token));
+      failHere("bad ", plyTypeName(t), " value ", quotedWord(token));
     long long lo = 0, hi = 0;
-    integerRange(t, lo, hi);
-    if (tooLarge || v < lo || v > hi) failHere("value ", token, " does not fit in a ", typeName(t), " property");
+    plyIntegerRange(t, lo, hi);
+    if (tooLarge || v < lo || v > hi) failHere("value ", token, " does not fit in a ", plyTypeName(t), " property");
     return v;
   }
 
@@ -330,7 +170,7 @@ class BinaryCursor {
 
  private:
   uint64_t raw(PlyType t) {
-    const size_t n = typeSize(t);
+    const size_t n = plyTypeSize(t);
     if (size_ - pos_ < n)
       fail<InputError>(path_, ": PLY file ends inside ", element_->name, " ", index_, " (truncated?)");
     uint64_t u = 0;
@@ -339,7 +179,7 @@ class BinaryCursor {
     return u;
   }
   static long long toInteger(PlyType t, uint64_t u) {
-    const size_t n = typeSize(t);
+    const size_t n = plyTypeSize(t);
     const bool isSigned = t == PlyType::Int8 || t == PlyType::Int16 || t == PlyType::Int32;
     if (isSigned && ((u >> (8 * n - 1)) & 1)) return static_cast<long long>(u) - (1LL << (8 * n));
     return static_cast<long long>(u);
@@ -374,15 +214,15 @@ void readInstance(Cursor& in, const PlyElement& e, size_t vertexCount, double xy
   for (const PlyProperty& p : e.properties) {
     if (!p.list) {
       const double v = in.real(p.valueType);
-      if (p.role == Role::Skip) continue;
+      if (p.role == PlyRole::Skip) continue;
       if (!std::isfinite(v)) in.failHere("coordinate ", p.name, " is NaN or infinite");
-      xyz[static_cast<int>(p.role) - static_cast<int>(Role::X)] = v;
+      xyz[static_cast<int>(p.role) - static_cast<int>(PlyRole::X)] = v;
       continue;
     }
     const long long n = in.integer(p.countType);
-    const size_t valueBytes = typeSize(p.valueType);
+    const size_t valueBytes = plyTypeSize(p.valueType);
     if (n < 0 || static_cast<unsigned long long>(n) > in.maxListLength(valueBytes)) in.failHere("bad list length ", n);
-    if (p.role == Role::Indices) {
+    if (p.role == PlyRole::Indices) {
       readFace(in, p, n, vertexCount, polygon);
     } else {
       for (long long k = 0; k < n; ++k) in.real(p.valueType);

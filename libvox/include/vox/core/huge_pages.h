@@ -5,7 +5,6 @@
 // time as parsing them from an OBJ text.
 #pragma once
 
-#include <algorithm>
 #include <cstddef>
 #include <memory>
 #include <new>
@@ -84,14 +83,6 @@ template <typename T, typename A>
 void reserveOnHugePages(std::vector<T, A>& v, size_t n) {
   v.reserve(n);
   adviseHugePages(v.data() + v.size(), (v.capacity() - v.size()) * sizeof(T));
-}
-
-// Before a push_back onto an array that may grow large: when it is full, doubles its capacity on huge pages, so
-// that a reader growing its arrays one element at a time (an OBJ's vertices and faces) does not fault them in
-// 4 KiB at a time.
-template <typename T, typename A>
-void growOnHugePages(std::vector<T, A>& v) {
-  if (v.size() == v.capacity()) reserveOnHugePages(v, std::max<size_t>(v.capacity() * 2, 1024));
 }
 
 }  // namespace vox

@@ -70,7 +70,7 @@ void buildTables(Accel& accel, const Grid& grid) {
     return (c[0] >> shift) + bd[0] * ((c[1] >> shift) + uint64_t(bd[1]) * (c[2] >> shift));
   };
   // Count occupied blocks first, so that a scattered grid falls back before allocating.
-  std::vector<uint32_t> slot(blockCount, kEmptyCell);
+  HugeVector<uint32_t> slot(blockCount, kEmptyCell);
   uint32_t used = 0;
   const uint64_t perBlock = uint64_t(1) << (3 * shift);
   const auto claim = [&](uint64_t key) {

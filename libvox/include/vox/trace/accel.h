@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "vox/core/grid.h"
+#include "vox/core/huge_pages.h"
 #include "vox/trace/intersect.h"
 #include "vox/core/scene.h"
 
@@ -55,11 +56,11 @@ struct FloatCells {
   struct Cell {
     uint32_t first, count;
   };
-  std::vector<Cell> cells;
-  std::vector<TriangleGroup4> groups;
+  HugeVector<Cell> cells;
+  HugeVector<TriangleGroup4> groups;
   // cells[] entries laid out as Accel::cellSlots ({0, 0} for empty and solid cells), so that a walk reads a cell's
   // groups with one dependent read less (Accel::floatCell). Empty when the accel has no block tables.
-  std::vector<Cell> slots;
+  HugeVector<Cell> slots;
 };
 
 inline constexpr uint32_t kEmptyCell = 0xffffffffu;
@@ -74,7 +75,7 @@ struct Accel {
   AccelKind kind = AccelKind::Grid;
   const Grid* grid = nullptr;  // not owned: the Grid must outlive the Accel
   uint32_t triangleCount = 0, sphereCount = 0, planeCount = 0;
-  std::vector<TriangleData> triangles;
+  HugeVector<TriangleData> triangles;
   std::vector<SphereData> spheres;
   std::vector<Plane> planes;
   // Planes and Grid::outsidePrims, ascending ids: tested for every ray, before the walk.
@@ -88,25 +89,25 @@ struct Accel {
   // or too scattered for tables, and lookups fall back to a binary search in grid->cellKeys.
   uint32_t blockShift = 0;
   std::array<uint32_t, 3> blockDims{0, 0, 0};
-  std::vector<uint32_t> blockSlot;
-  std::vector<uint32_t> cellSlots;
+  HugeVector<uint32_t> blockSlot;
+  HugeVector<uint32_t> cellSlots;
   // Per block (blockSlot order): 0 when the block holds a cell, else the largest s >= blockShift such that the
   // aligned box of 2^s cells a side holding the block is empty (cells past the grid count as empty; s stops at the
   // box holding the whole grid), so that a walk skips a run of empty space in one jump per box rather than per block
   // (GridWalker::fastForward; issue 12). Empty when there are no block tables.
-  std::vector<uint8_t> emptyShift;
+  HugeVector<uint8_t> emptyShift;
   // The triangles of the cells, copied in cell order: cellTriangles[r] == triangles[grid->primIds[r]] when that id is
   // a triangle (unused otherwise). A walk then reads a cell's triangles from one run of memory instead of one random
   // place each (a dependent cache miss per test for incoherent rays, issue 12); the same values, so the same t.
   // Empty when it would take more than kMaxCellTriangleBytes; walks then read `triangles` by id.
-  std::vector<TriangleData> cellTriangles;
+  HugeVector<TriangleData> cellTriangles;
   // The float copies of the cells' triangles for the single-ray walk (AccelKind::Grid; empty over the budget).
   FloatCells floatCells;
   // Per cell slot (laid out as cellSlots), for an empty or solid cell: the box of cells around it that holds no
   // primitive, as the number of cells it reaches below and above the cell on each axis (0 for an occupied cell).
   // A walk that enters such a cell has nothing to test until it leaves the box, and jumps to its exit (issue 27;
   // trace/cell_boxes.cpp). Empty for AccelKind::Uniform, without block tables, or for grids over kMaxBoxGridCells.
-  std::vector<CellBox> cellBoxes;
+  HugeVector<CellBox> cellBoxes;
 
   uint32_t primitiveCount() const { return triangleCount + sphereCount + planeCount; }
 

@@ -158,7 +158,7 @@ void buildEmptyShift(Accel& accel);
 inline constexpr uint64_t kMaxBoxGridCells = uint64_t(1) << 25;
 void buildCellBoxes(Accel& accel);
 
-inline constexpr uint64_t kMaxCellTriangleBytes = uint64_t(512) << 20;
+inline constexpr uint64_t kMaxCellTriangleBytes = uint64_t(128) << 20;
 
 // The ray test of primitive `id` (any kind), as every traversal calls it.
 inline bool intersectPrimitive(const Accel& accel, uint32_t id, const Ray& ray, double& t) {

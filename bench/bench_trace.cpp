@@ -546,7 +546,7 @@ void benchIncoherent(const std::string& path, unsigned threads, uint32_t size, i
               factor > 0 ? ("cells/triangle " + std::to_string(factor).substr(0, 4)).c_str() : "default", grid.dims[0],
               grid.dims[1], grid.dims[2], sets[0].rays.size());
   // What the cell boxes cost on top of the uniform walk's structure (issue 27's build goal): their build alone, best
-  // of 3 on a copy of the uniform accel (one thread: buildCellBoxes is serial), and their bytes.
+  // of 3 on a copy of the uniform accel (on the bench's threads, as buildAccel builds them), and their bytes.
   double boxSeconds = 1e300;
   for (int r = 0; r < 3; ++r) {
     vox::Accel copy = uniform;

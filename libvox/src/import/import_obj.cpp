@@ -131,7 +131,7 @@ Scene importObj(const std::string& path) {
   const bool textured = !scene.textures.empty();
   checkMemory(double(obj.triangles.size()) * (sizeof(Triangle) + (textured ? sizeof(std::array<TexCoord, 3>) : 0)),
               path, "making " + std::to_string(obj.triangles.size()) + " triangles");
-  reserveOnHugePages(scene.triangles, obj.triangles.size());
+  scene.triangles.reserve(obj.triangles.size());
   std::vector<Material> clones;  // untextured copies, materials defaultMaterial + 1 + k
   std::map<uint32_t, uint32_t> cloneOf;
   bool warnedNoTexcoords = false;

@@ -27,9 +27,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <filesystem>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -180,8 +178,7 @@ class BinaryCursor {
   }
   static long long toInteger(PlyType t, uint64_t u) {
     const size_t n = plyTypeSize(t);
-    const bool isSigned = t == PlyType::Int8 || t == PlyType::Int16 || t == PlyType::Int32;
-    if (isSigned && ((u >> (8 * n - 1)) & 1)) return static_cast<long long>(u) - (1LL << (8 * n));
+    if (isPlySigned(t) && ((u >> (8 * n - 1)) & 1)) return static_cast<long long>(u) - (1LL << (8 * n));
     return static_cast<long long>(u);
   }
 
@@ -255,9 +252,9 @@ PlyMesh readBody(Cursor in, const PlyHeader& h) {
   size_t vertexCount = 0;
   for (const PlyElement& e : h.elements) {
     if (e.name == "vertex") vertexCount = static_cast<size_t>(e.count);
-    if (e.name == "face") reserveOnHugePages(out.triangles, static_cast<size_t>(e.count));
+    if (e.name == "face") out.triangles.reserve(static_cast<size_t>(e.count));
   }
-  reserveOnHugePages(out.vertices, vertexCount);
+  out.vertices.reserve(vertexCount);
   for (const PlyElement& e : h.elements) readElement(in, e, vertexCount, out);
   return out;
 }
@@ -358,7 +355,7 @@ Scene importPly(const std::string& path) {
 
   Scene scene;
   scene.materials.push_back(Material{"default"});
-  reserveOnHugePages(scene.triangles, mesh.triangles.size());
+  scene.triangles.reserve(mesh.triangles.size());
   for (const auto& f : mesh.triangles)
     scene.triangles.push_back({{mesh.vertices[f[0]], mesh.vertices[f[1]], mesh.vertices[f[2]]}, 0});
   if (mesh.shortFaces > 0)

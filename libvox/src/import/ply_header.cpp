@@ -56,11 +56,12 @@ size_t plyTypeSize(PlyType t) {
 
 bool isPlyFloat(PlyType t) { return t == PlyType::Float32 || t == PlyType::Float64; }
 
+bool isPlySigned(PlyType t) { return t == PlyType::Int8 || t == PlyType::Int16 || t == PlyType::Int32; }
+
 void plyIntegerRange(PlyType t, long long& lo, long long& hi) {
   const int bits = 8 * static_cast<int>(plyTypeSize(t));
-  const bool isSigned = t == PlyType::Int8 || t == PlyType::Int16 || t == PlyType::Int32;
-  lo = isSigned ? -(1LL << (bits - 1)) : 0;
-  hi = isSigned ? (1LL << (bits - 1)) - 1 : (1LL << bits) - 1;
+  lo = isPlySigned(t) ? -(1LL << (bits - 1)) : 0;
+  hi = isPlySigned(t) ? (1LL << (bits - 1)) - 1 : (1LL << bits) - 1;
 }
 
 PlyHeader parseHeader(std::string_view data, const std::string& path) {

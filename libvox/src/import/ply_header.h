@@ -18,6 +18,7 @@ std::optional<PlyType> plyType(std::string_view t);
 const char* plyTypeName(PlyType t);
 size_t plyTypeSize(PlyType t);
 bool isPlyFloat(PlyType t);
+bool isPlySigned(PlyType t);
 // The range of an integer type.
 void plyIntegerRange(PlyType t, long long& lo, long long& hi);
 

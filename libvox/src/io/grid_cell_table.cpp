@@ -56,7 +56,7 @@ EncodedCellTable encodeCellTable(const Grid& grid) {
     offset[i + 1] = size;
   });
   for (size_t i = 0; i < chunks; ++i) offset[i + 1] += offset[i];
-  reserveOnHugePages(table.bytes, offset[chunks]);
+  table.bytes.reserve(offset[chunks]);
   table.bytes.resize(offset[chunks]);
   tbb::parallel_for(size_t(0), chunks, [&](size_t i) {
     uint8_t* p = reinterpret_cast<uint8_t*>(table.bytes.data()) + offset[i];
@@ -117,9 +117,9 @@ void getCellTable(ByteReader& r, Grid& grid, uint64_t bounded) {
                      " references do not fit its ", size, " bytes");
   const uint64_t cells = grid.cellCount();
   const uint64_t idLimit = std::min<uint64_t>(bounded, uint64_t(std::numeric_limits<uint32_t>::max()) + 1);
-  reserveOnHugePages(grid.cellKeys, occupied);
-  reserveOnHugePages(grid.cellStart, occupied + 1);
-  reserveOnHugePages(grid.primIds, references);
+  grid.cellKeys.reserve(occupied);
+  grid.cellStart.reserve(occupied + 1);
+  grid.primIds.reserve(references);
   grid.cellKeys.resize(occupied);
   grid.cellStart.resize(occupied + 1);
   grid.primIds.resize(references);

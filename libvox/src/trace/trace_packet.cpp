@@ -348,9 +348,7 @@ void testCells(Packet& p, int64_t slice, const std::array<int64_t, 3>& ru, const
         }
         uint64_t hitBits = 0;
         if (id < accel.triangleCount) {
-          // The cell's own copy when there is one (Accel::cellTriangles): the same values, read from the run of
-          // memory after the cell's ids instead of a random place.
-          const TriangleData& tri = accel.cellTriangles.empty() ? accel.triangles[id] : accel.cellTriangles[ref];
+          const TriangleData& tri = cellTriangle(accel, ref, id);
           if (outsidePacket(tri, p.k, p.other, p.c0, p.bounds)) continue;
           p.st.tests += lanes.count;
           hitBits = triangleLanes(tri, lanes);

@@ -345,9 +345,9 @@ VoxelizeStats gatherReferences(tbb::enumerable_thread_specific<Local>& locals, b
   grid.primIds.clear();
   // Sized once, never grown (a grown array is copied and faulted in again): a cell holds at least one reference, so
   // `total` bounds the cells. Capacity past the cells is address space only: untouched pages take no memory.
-  reserveOnHugePages(grid.primIds, total);
-  reserveOnHugePages(grid.cellKeys, total);
-  reserveOnHugePages(grid.cellStart, total + 1);
+  grid.primIds.reserve(total);
+  grid.cellKeys.reserve(total);
+  grid.cellStart.reserve(total + 1);
   if (packed) {
     std::vector<std::span<const uint64_t>> parts;
     for (auto& l : locals) parts.emplace_back(l.packedRefs);
@@ -583,7 +583,7 @@ void voxelizeWindow(const Scene& scene, Grid& grid, const CellWindow& window, co
   const size_t perThread = size_t(std::min(estimate, estimate * 2 / threads)) + 4096;
   tbb::enumerable_thread_specific<Local> locals([&] {
     Local l;
-    if (ctx.packed) reserveOnHugePages(l.packedRefs, perThread);
+    if (ctx.packed) l.packedRefs.reserve(perThread);
     return l;
   });
   std::atomic<size_t> done{0};

@@ -78,7 +78,8 @@ HugeArray<T> makeHugeArray(size_t n) {
   return HugeArray<T>(HugePageAllocator<T>().allocate(n), HugeArrayDeleter<T>{n});
 }
 
-// v.reserve(n), then adviseHugePages on the capacity not yet written (the part the kernel has not faulted in).
+// v.reserve(n), then adviseHugePages on the capacity not yet written (the part the kernel has not faulted in): for a
+// std::vector whose block malloc places. A HugeVector needs only reserve(): its allocator maps whole huge pages.
 template <typename T, typename A>
 void reserveOnHugePages(std::vector<T, A>& v, size_t n) {
   v.reserve(n);

@@ -168,11 +168,17 @@ inline bool intersectPrimitive(const Accel& accel, uint32_t id, const Ray& ray, 
   return intersectPlane(accel.planes[s - accel.sphereCount], ray, t);
 }
 
-// The same test for the primitive at position `ref` of grid->primIds (id == grid->primIds[ref]), reading a triangle
-// from Accel::cellTriangles when there is one: the same TriangleData, so the same result and t.
+// Triangle `id` at position `ref` of grid->primIds (id == grid->primIds[ref] < triangleCount): its copy in
+// Accel::cellTriangles when there is one, read from the run of memory after the cell's ids instead of a random
+// place; the same TriangleData either way.
+inline const TriangleData& cellTriangle(const Accel& accel, uint64_t ref, uint32_t id) {
+  return accel.cellTriangles.empty() ? accel.triangles[id] : accel.cellTriangles[ref];
+}
+
+// The test of intersectPrimitive for the primitive at position `ref` of grid->primIds (id == grid->primIds[ref]),
+// reading a triangle through cellTriangle: the same TriangleData, so the same result and t.
 inline bool intersectCellPrimitive(const Accel& accel, uint64_t ref, uint32_t id, const Ray& ray, double& t) {
-  if (id < accel.triangleCount && !accel.cellTriangles.empty())
-    return intersectTriangle(accel.cellTriangles[ref], ray, t);
+  if (id < accel.triangleCount) return intersectTriangle(cellTriangle(accel, ref, id), ray, t);
   return intersectPrimitive(accel, id, ray, t);
 }
 

@@ -10,7 +10,7 @@ build=${1:-$root/build}
 shift || true
 resolutions=("${@:-256 1024 2048}")
 read -r -a resolutions <<<"${resolutions[*]}"
-seed=${VOX_SEED_DIR:-$root/../shared/seed-scenes}
+seed=${VOX_SEED_DIR:-$root/data}
 meshes=("${MESHES:-$seed/meshes/bun_zipper.ply $seed/6837/scenes/bunny_40k.obj}")
 read -r -a meshes <<<"${meshes[*]}"
 repeat=${REPEAT:-3}

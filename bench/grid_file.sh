@@ -10,7 +10,7 @@ build=${1:?usage: PREVIOUS=DIR bench/grid_file.sh BUILD_DIR [RESOLUTIONS...]}
 shift
 previous=${PREVIOUS:?set PREVIOUS to the folder of the previous build tools}
 resolutions=("${@:-1024 2048}")
-mesh=${MESH:-${VOX_SEED_DIR:-$root/../shared/seed-scenes}/meshes/derived/stanford_bunny_69k.obj}
+mesh=${MESH:-${VOX_SEED_DIR:-$root/data}/meshes/derived/stanford_bunny_69k.obj}
 repeat=${REPEAT:-5}
 tmp=$(mktemp -d "${TMPDIR:-/var/tmp}/gridfile.XXXXXX")  # a disk, not tmpfs: sync must cost what it costs
 trap 'rm -rf "$tmp"' EXIT

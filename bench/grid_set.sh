@@ -15,7 +15,7 @@ set -euo pipefail
 BIN=$(cd "$1" && pwd)
 shift
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
-MESH=${MESH:-${VOX_SEED_DIR:-$ROOT/../shared/seed-scenes}/meshes/bun_zipper.ply}
+MESH=${MESH:-${VOX_SEED_DIR:-$ROOT/data}/meshes/bun_zipper.ply}
 OUT=${OUT:-/tmp/vox_bench_set}
 mkdir -p "$OUT"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
@@ -42,7 +42,7 @@ make_batch() {  # make_batch N: N OBJ files, each a seed mesh under a random rot
   local n=$1
   [ -f "$OUT/batch_$n/list.txt" ] && return
   mkdir -p "$OUT/batch_$n"
-  python3 - "$ROOT" "$OUT/batch_$n" "$n" "${VOX_SEED_DIR:-$ROOT/../shared/seed-scenes}" <<'PY'
+  python3 - "$ROOT" "$OUT/batch_$n" "$n" "${VOX_SEED_DIR:-$ROOT/data}" <<'PY'
 import math, random, sys, os
 root, out, n, seed = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4]
 def load(path):

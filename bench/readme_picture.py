@@ -11,7 +11,7 @@ import sys
 import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-SEED = os.environ.get("VOX_SEED_DIR", os.path.join(ROOT, "..", "shared", "seed-scenes"))
+SEED = os.environ.get("VOX_SEED_DIR", os.path.join(ROOT, "data"))
 OUT = os.path.join(ROOT, "docs", "images", "hero.png")
 SIZE = 400
 

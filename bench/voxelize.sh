@@ -10,7 +10,7 @@ build=${1:-$root/build}
 shift || true
 resolutions=("${@:-256 1024 2048}")
 read -r -a resolutions <<<"${resolutions[*]}"
-mesh=${MESH:-${VOX_SEED_DIR:-$root/../shared/seed-scenes}/meshes/bun_zipper.ply}
+mesh=${MESH:-${VOX_SEED_DIR:-$root/data}/meshes/bun_zipper.ply}
 repeat=${REPEAT:-3}
 threads=${THREADS:-$(nproc)}
 tmp=$(mktemp -d)

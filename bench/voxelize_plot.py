@@ -27,7 +27,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 IMAGES = os.path.join(ROOT, "docs", "images")
 CSV = os.path.join(IMAGES, "voxelize_scaling.csv")
 PNG = os.path.join(IMAGES, "voxelize_scaling.png")
-SEED = os.environ.get("VOX_SEED_DIR", os.path.join(ROOT, "..", "shared", "seed-scenes"))
+SEED = os.environ.get("VOX_SEED_DIR", os.path.join(ROOT, "data"))
 
 OPEN3D = r"""
 import resource, sys, time

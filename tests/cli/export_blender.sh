@@ -29,7 +29,7 @@ fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
 "$build/vox-voxelize" "$src/tests/data/two_materials.obj" -o "$tmp/small.vgrid" --grid 16 10 10 --quiet ||
   { echo "FAIL: voxelize"; exit 1; }
 grids=small
-seed=${VOX_SEED_DIR:-$src/../shared/seed-scenes}/6837/scenes
+seed=${VOX_SEED_DIR:-$src/data}/6837/scenes
 # Under the sanitizers (CI's second pass, the same writers ten times slower) the small scene suffices.
 sanitized=$(grep -s '^VOX_SANITIZE:BOOL=ON' "$build/CMakeCache.txt")
 if [ -z "$sanitized" ] && [ -f "$seed/scene5_09_bunny_mesh_40k.txt" ]; then

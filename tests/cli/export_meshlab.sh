@@ -2,7 +2,7 @@
 # A real client: MeshLab's meshlabserver, run headless under Xvfb, opens exported PLY files and its "Compute
 # Topological Measures" filter must report no boundary edge and a two-manifold mesh, for the exposed and merged
 # surfaces: on a small scene with voxels meeting along edges and at corners, on every course scene of assignments
-# 5 and 6 at its handout grid (../shared/seed-scenes/6837/README.md, the list of tests/render_test.cpp), and on the
+# 5 and 6 at its handout grid (data/6837/README.md, the list of tests/render_test.cpp), and on the
 # 40k bunny at 64 and 128 cells per axis (issue 10: MeshLab triangulated merged polygons with collinear vertices
 # into zero-area triangles and reported non-two-manifold edges). OBJ is not opened: MeshLab's OBJ importer aborts
 # on every OBJ on Debian 12 (Debian bug 1054006). Skips (exit 0) when meshlabserver or xvfb-run is missing; CI
@@ -54,7 +54,7 @@ echo "small-merged-off $mesh" >>"$list"
 
 # Course scenes at their handout grids (scenes without a -grid line: 10 10 10), material colours (one colour per
 # object, so the largest rectangles and the most vertices on their sides), and the 40k bunny finer.
-seed=${VOX_SEED_DIR:-$src/../shared/seed-scenes}/6837/scenes
+seed=${VOX_SEED_DIR:-$src/data}/6837/scenes
 # CI runs every test twice, the second time under sanitizers: the course scenes (about 80 MeshLab runs) once.
 sanitized=$(grep -s '^VOX_SANITIZE:BOOL=ON' "$build/CMakeCache.txt")
 if [ -n "$sanitized" ]; then

@@ -32,7 +32,7 @@ sanitized=$(grep -s '^VOX_SANITIZE:BOOL=ON' "$build/CMakeCache.txt")
 "$build/vox-voxelize" "$src/tests/data/two_materials.obj" -o "$tmp/two.vgrid" --grid 300 12 10 --quiet ||
   fail "voxelize two_materials"
 grids="cube two"
-bunny=${VOX_SEED_DIR:-$src/../shared/seed-scenes}/meshes/bun_zipper.ply
+bunny=${VOX_SEED_DIR:-$src/data}/meshes/bun_zipper.ply
 if [ -z "$sanitized" ] && [ -f "$bunny" ]; then
   "$build/vox-voxelize" "$bunny" -o "$tmp/bunny.vgrid" --res 160 --fill --quiet || fail "voxelize bunny"
   grids="$grids bunny"

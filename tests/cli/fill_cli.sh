@@ -36,7 +36,7 @@ grep -q '^vox-voxelize: fill: |winding number| >= 0.5 (mesh has 4 open edges), [
 # winding number is about 0.6; the layer above the hole (about 0.4) stays out.
 [ "$(solid)" = 252 ] || fail "open cube: $(solid) solid cells, expected 6 x 6 x 7 = 252"
 
-bunny=${VOX_SEED_DIR:-$src/../shared/seed-scenes}/meshes/bun_zipper.ply
+bunny=${VOX_SEED_DIR:-$src/data}/meshes/bun_zipper.ply
 if [ -f "$bunny" ]; then
   fill_line "$bunny" --res "$res"
   want='^vox-voxelize: fill: |winding number| >= 0.5 (mesh has 223 open edges), [1-9][0-9]* solid cells'

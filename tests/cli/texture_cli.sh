@@ -6,7 +6,7 @@
 set -u
 build=$1
 src=$2
-seed=${VOX_SEED_DIR:-$src/../shared/seed-scenes}/gltf
+seed=${VOX_SEED_DIR:-$src/data}/gltf
 voxelize=$build/vox-voxelize
 export_tool=$build/vox-export
 [ -x "$voxelize" ] && [ -x "$export_tool" ] || { echo "SKIP: tools not built"; exit 0; }

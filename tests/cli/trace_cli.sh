@@ -5,7 +5,7 @@
 set -u
 BUILD=$1
 SRC=$2
-SEED="${VOX_SEED_DIR:-$SRC/../shared/seed-scenes}/6837/scenes"
+SEED="${VOX_SEED_DIR:-$SRC/data}/6837/scenes"
 TRACE="$BUILD/vox-trace"
 VOXELIZE="$BUILD/vox-voxelize"
 WORK=$(mktemp -d)
@@ -106,7 +106,7 @@ frame eye_sq 24 24 --eye 0 2 10 --look-at 0 1 5
 frame eye_sq_fov 24 24 --eye 0 2 10 --look-at 0 1 5 --fov 30
 cmp -s "$WORK/cam_eye_sq.png" "$WORK/cam_eye_sq_fov.png" || fail "--eye on a square image: --fov 30 changed it"
 # A glTF camera (yfov 0.7 radians) is vertical: a wide image with it and with --fov of the same angle is one file.
-GLTF="${VOX_SEED_DIR:-$SRC/../shared/seed-scenes}/gltf/Cameras/glTF/Cameras.gltf"
+GLTF="${VOX_SEED_DIR:-$SRC/data}/gltf/Cameras/glTF/Cameras.gltf"
 "$VOXELIZE" "$GLTF" -o "$WORK/gltf.vgrid" --grid 4 4 1 -q || fail "voxelize glTF camera scene"
 yfov=$(python3 -c 'import math; print(repr(0.7 * 180 / math.pi))')
 for fov in "" "--fov $yfov"; do

@@ -4,7 +4,7 @@
 set -u
 BIN=$1
 SRC=$2
-SEED=${VOX_SEED_DIR:-$SRC/../shared/seed-scenes}
+SEED=${VOX_SEED_DIR:-$SRC/data}
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 fails=0

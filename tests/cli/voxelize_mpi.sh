@@ -90,7 +90,7 @@ fill_case() {  # fill_case TAG SCENE "ARGS" "BRICKS" "RANK COUNTS"
   done
 }
 fill_case fbunny "$S/scene5_07_bunny_mesh_1k.txt" "--grid 15 15 12" "3 2 2" "$SOME_K"
-fill_case fopen "${VOX_SEED_DIR:-$SRC/../shared/seed-scenes}/meshes/bun_zipper.ply" "--res 20" "7 5 3" "2"
+fill_case fopen "${VOX_SEED_DIR:-$SRC/data}/meshes/bun_zipper.ply" "--res 20" "7 5 3" "2"
 
 # A failing rank: bricks cannot be written (each about 300 KB, over a 64 KiB file-size limit; the scene file is
 # small). The run fails with that message, exit 3, on every rank count; no manifest, and no file of the new set:
@@ -116,7 +116,7 @@ check "old set after a failing rank" 0 "$I" "$T/rr.vgrid" --json --cells --primi
 same "old set reads as before after a failing rank" "$T/rr.json" "$T/out"
 # A rank killed (SIGTERM) once bricks are written: its handler removes the new set's folder, mpirun ends the job, no
 # manifest is written (rank 0 waits for every rank's outcome first); the old set stays whole.
-$RUN 2 "$M" "${VOX_SEED_DIR:-$SRC/../shared/seed-scenes}/meshes/bun_zipper.ply" -o "$T/rr.vgrid" --res 1600 \
+$RUN 2 "$M" "${VOX_SEED_DIR:-$SRC/data}/meshes/bun_zipper.ply" -o "$T/rr.vgrid" --res 1600 \
   --bricks 8 8 8 -q 2>"$T/err" &
 pid=$!
 for _ in $(seq 600); do

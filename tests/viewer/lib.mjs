@@ -12,7 +12,7 @@ import { inflateSync } from 'node:zlib';
 
 export const build = resolve(process.argv[2] ?? 'build');
 export const source = resolve(process.argv[3] ?? '.');
-export const seed = process.env.VOX_SEED_DIR ?? join(source, '..', 'shared', 'seed-scenes');
+export const seed = process.env.VOX_SEED_DIR ?? join(source, 'data');
 export const chromiumPath = process.env.VOX_CHROMIUM ?? '/usr/bin/chromium';
 export const SKIP = 77;
 

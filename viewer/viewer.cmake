@@ -6,7 +6,7 @@
 option(VOX_VIEWER "Build the viewer page of vox-export (-o OUT.html); needs Node.js and npm at build time" ON)
 # The page's data is deflated (zlib, which Debian's OpenVDB and OpenImageIO already bring).
 find_package(ZLIB REQUIRED)
-target_link_libraries(vox PRIVATE ZLIB::ZLIB)
+target_link_libraries(vox PRIVATE $<BUILD_INTERFACE:ZLIB::ZLIB>)
 if(NOT VOX_VIEWER)
   return()
 endif()

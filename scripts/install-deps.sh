@@ -9,6 +9,9 @@ packages=(build-essential cmake ninja-build pkg-config python3
   libopenvdb-dev  # vox-export writes .vdb (export/vdb_writer.cpp)
   # The Python package (python/, docs/python.md) and its tests.
   python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-setuptools python3-venv python3-pip
+  # Packaging (issue 36): cpack's Debian package (dpkg-shlibdeps), man pages from --help; Dask for the Python test that
+  # voxelizes over a LocalCluster; ccache, used by the build when present.
+  dpkg-dev help2man python3-dask python3-distributed ccache
   # The viewer page (vox-export -o OUT.html, viewer/): its script is bundled at build time with Node.js and npm.
   nodejs)
 # npm: Debian's package, unless an npm is already there (NodeSource's nodejs brings its own, and Debian's npm would

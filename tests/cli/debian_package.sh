@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # cpack -G DEB makes a Debian package users install as they install everything else (issue 36): it holds the tools,
 # the library, the public headers, the CMake package, the pkg-config file and the man pages; its Depends name the
-# Debian 12 runtime packages (dpkg-shlibdeps); unpacked (dpkg-deb -x, no root needed), its vox-voxelize runs.
+# Debian 12 runtime packages (dpkg-shlibdeps), which apt resolves; unpacked (dpkg-deb -x, no root needed), its vox-voxelize runs.
 # Usage: debian_package.sh BUILD_DIR SOURCE_DIR
 set -u
 build=$1
@@ -33,6 +33,9 @@ for f in libvox.a libvox_oiio.so cmake/libvox/libvoxConfig.cmake cmake/libvox/li
 done
 ! grep -q "vox/core/varint.h" "$tmp/contents" || fail "the package holds an internal header"
 
+# apt resolves its Depends from Debian 12's archive (a simulation: no root, nothing installed).
+apt-get install -s "$deb" >"$tmp/apt.log" 2>&1 && grep -q "^Inst libvox " "$tmp/apt.log" ||
+  fail "apt-get install -s refuses the package: $(tail -5 "$tmp/apt.log")"
 dpkg-deb -x "$deb" "$tmp/root"
 out=$("$tmp/root/usr/bin/vox-voxelize" --version 2>&1) || fail "unpacked vox-voxelize --version exited $?"
 [ "$out" = "libvox $version" ] || fail "unpacked vox-voxelize --version printed '$out'"

@@ -139,6 +139,35 @@ std::string repr(const PyGrid& self) {
   return out.str();
 }
 
+// Pickling (Grid.__getstate__): the state is (bytes of the grid file, source), the bytes being exactly what
+// grid.save("x.vgrid") writes (vox::encodeGridFile: the scene, the cells, the solid runs and every optional section),
+// so a grid sent to another process or machine is the same grid cell for cell and primitive for primitive.
+py::object getState(const PyGrid& self) {
+  std::string bytes;
+  {
+    py::gil_scoped_release release;
+    bytes = vox::encodeGridFile(self.scene(), self.grid());
+  }
+  return py::make_tuple(py::bytes(bytes), self.source());
+}
+
+// Grid.__setstate__: decodes the bytes with every check libvox.load makes (counts, offsets, ids, checksum), so a
+// truncated or corrupt pickle raises InputError; a state that is not (bytes, str) raises TypeError.
+std::shared_ptr<PyGrid> setState(const py::object& state) {
+  if (!py::isinstance<py::tuple>(state) || py::len(state) != 2 || !py::isinstance<py::bytes>(state[py::int_(0)]) ||
+      !py::isinstance<py::str>(state[py::int_(1)]))
+    throw py::type_error("libvox.Grid.__setstate__: the state must be a tuple (bytes of a grid file, source str), "
+                         "got " + std::string(py::str(py::type::of(state).attr("__name__"))));
+  std::string bytes = state[py::int_(0)].cast<std::string>();
+  const std::string source = state[py::int_(1)].cast<std::string>();
+  vox::GridFile file;
+  {
+    py::gil_scoped_release release;
+    file = vox::decodeGridFile(bytes, "pickled grid (" + source + ")");
+  }
+  return std::make_shared<PyGrid>(std::move(file), source);
+}
+
 }  // namespace
 
 GridClass bindGrid(py::module_& m) {
@@ -151,6 +180,8 @@ precision); its centre is the midpoint. A primitive touching a cell's face, edge
 Occupied cells hold primitives; solid cells (voxelize(..., fill=True)) are empty cells inside closed surfaces.
 
 Made by libvox.voxelize, libvox.voxelize_batch(..., dense=False) and libvox.load; written by Grid.save.
+Pickles (multiprocessing, concurrent.futures, Dask) as the bytes of its grid file, the same bytes Grid.save writes
+to a .vgrid, with its source; unpickling checks them as libvox.load does (InputError for corrupt bytes).
 Arrays returned by properties are computed on each access unless noted (keep the result in a loop).
 )doc");
   grid.def_property_readonly(
@@ -229,7 +260,15 @@ For each point of `points` ((P, 3) float), whether a closed cell holding it is o
 on a boundary between cells counts for both; points outside the bounds are False.
 )doc")
       .def_property_readonly("source", &PyGrid::source, "Where the grid came from: a file path, or '<arrays>'.")
-      .def("__repr__", &repr);
+      .def("__repr__", &repr)
+      .def(py::pickle(&getState, &setState))
+      // What pickle calls (every protocol, and copy.copy / copy.deepcopy): made as protocol 2 makes it, so that
+      // protocols 0 and 1 too go through Grid.__new__ and __setstate__ (their default, copyreg._reconstructor,
+      // cannot make a pybind11 object and aborts the interpreter).
+      .def("__reduce__", [](const py::object& self) {
+        return py::make_tuple(py::module_::import("copyreg").attr("__newobj__"), py::make_tuple(py::type::of(self)),
+                              getState(self.cast<const PyGrid&>()));
+      });
 
   m.def(
       "load",

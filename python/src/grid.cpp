@@ -156,8 +156,10 @@ py::object getState(const PyGrid& self) {
 std::shared_ptr<PyGrid> setState(const py::object& state) {
   if (!py::isinstance<py::tuple>(state) || py::len(state) != 2 || !py::isinstance<py::bytes>(state[py::int_(0)]) ||
       !py::isinstance<py::str>(state[py::int_(1)]))
-    throw py::type_error("libvox.Grid.__setstate__: the state must be a tuple (bytes of a grid file, source str), "
-                         "got " + std::string(py::str(py::type::of(state).attr("__name__"))));
+    throw py::type_error(
+        "libvox.Grid.__setstate__: the state must be a tuple (bytes of a grid file, source str), "
+        "got " +
+        std::string(py::str(py::type::of(state).attr("__name__"))));
   std::string bytes = state[py::int_(0)].cast<std::string>();
   const std::string source = state[py::int_(1)].cast<std::string>();
   vox::GridFile file;

@@ -47,7 +47,7 @@ install(FILES ${CMAKE_BINARY_DIR}/libvox.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/
 
 # Man pages from each tool's --help and --version (help2man), made at build time only when help2man is installed.
 find_program(VOX_HELP2MAN help2man)
-if(VOX_HELP2MAN)
+if(VOX_HELP2MAN AND NOT VOX_SANITIZE AND NOT VOX_FUZZ)  # instrumented tools: no pages needed
   foreach(tool vox-voxelize vox-info vox-trace vox-export)
     add_custom_command(OUTPUT ${CMAKE_BINARY_DIR}/man/${tool}.1
       COMMAND ${CMAKE_COMMAND} -E make_directory ${CMAKE_BINARY_DIR}/man

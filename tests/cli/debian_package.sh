@@ -15,7 +15,8 @@ command -v dpkg-shlibdeps >/dev/null || { echo "FAIL: dpkg-shlibdeps missing (dp
   { tail -30 "$tmp/cpack.log"; echo "FAIL: cpack"; exit 1; }
 deb=$(find "$tmp/out" -maxdepth 1 -name 'libvox_*.deb' | head -1)
 [ -n "$deb" ] || { echo "FAIL: no .deb in $tmp/out"; ls "$tmp/out"; exit 1; }
-version=$(sed -n 's/^project(libvox VERSION \([0-9.]*\).*/\1/p' "$src/CMakeLists.txt")
+version=$(sed -n 's/^CMAKE_PROJECT_VERSION:STATIC=//p' "$build/CMakeCache.txt")  # project(libvox VERSION ...)
+[ -n "$version" ] || { echo "FAIL: no CMAKE_PROJECT_VERSION in $build/CMakeCache.txt"; exit 1; }
 [ "$(dpkg-deb -f "$deb" Package)" = libvox ] || fail "Package: $(dpkg-deb -f "$deb" Package)"
 [ "$(dpkg-deb -f "$deb" Version)" = "$version" ] || fail "Version: $(dpkg-deb -f "$deb" Version), not $version"
 depends=$(dpkg-deb -f "$deb" Depends)
@@ -41,8 +42,8 @@ out=$("$tmp/root/usr/bin/vox-voxelize" --version 2>&1) || fail "unpacked vox-vox
 [ "$out" = "libvox $version" ] || fail "unpacked vox-voxelize --version printed '$out'"
 "$tmp/root/usr/bin/vox-voxelize" "$src/scenes/scene5_02_spheres.txt" -o "$tmp/s.vgrid" -q || fail "unpacked vox-voxelize"
 "$tmp/root/usr/bin/vox-trace" "$tmp/s.vgrid" -o "$tmp/s.png" --size 16 16 -q || fail "unpacked vox-trace (OpenImageIO module)"
-man -l "$tmp/root/usr/share/man/man1/vox-voxelize.1" 2>/dev/null | grep -q -- "--fill" ||
-  zcat -f "$tmp/root/usr/share/man/man1/vox-voxelize.1"* | grep -q -- "fill" || fail "man page of vox-voxelize lacks --fill"
+# help2man writes each flag with escaped dashes (\fB\-\-fill\fR): the page holds the tool's own --help.
+grep -qF -- '\-\-fill' "$tmp/root/usr/share/man/man1/vox-voxelize.1" || fail "man page of vox-voxelize lacks --fill"
 
 [ "$failures" -eq 0 ] || { echo "$failures failure(s)"; exit 1; }
 echo "debian_package: $(basename "$deb"), Depends: $depends"

@@ -21,14 +21,9 @@
 namespace vox {
 namespace {
 
-namespace fs = std::filesystem;
+using testing::readAll;
 
-std::string readAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+namespace fs = std::filesystem;
 
 void writePlain(const std::string& path, const std::string& bytes) { std::ofstream(path, std::ios::binary) << bytes; }
 

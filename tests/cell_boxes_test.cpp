@@ -7,12 +7,15 @@
 #include <random>
 #include <vector>
 
+#include "render_util.h"
 #include "vox/trace/accel.h"
 #include "vox/trace/traverse.h"
 #include "vox/voxelize/voxelize.h"
 
 namespace vox {
 namespace {
+
+using testing::voxelizeWith;
 
 // A few small triangles scattered in the unit cube: wide empty spaces between them.
 Scene scatteredTriangles(std::mt19937& rng, int count, double scale, const Vec3& offset) {
@@ -27,13 +30,6 @@ Scene scatteredTriangles(std::mt19937& rng, int count, double scale, const Vec3&
     scene.triangles.push_back(tri);
   }
   return scene;
-}
-
-Grid voxelizeDims(const Scene& scene, std::array<uint32_t, 3> dims) {
-  VoxelizeOptions o;
-  o.dims = dims;
-  o.method = OverlapMethod::Exact;
-  return voxelizeScene(scene, o);
 }
 
 bool occupied(const Accel& a, uint32_t i, uint32_t j, uint32_t k) {
@@ -87,7 +83,7 @@ TEST(CellBoxes, ValidAndMaximalOnScatteredScenes) {
   uint64_t checked = 0;
   for (const std::array<uint32_t, 3> dims : {std::array<uint32_t, 3>{1, 1, 1}, {7, 5, 3}, {24, 24, 24}, {40, 3, 17}}) {
     const Scene scene = scatteredTriangles(rng, 6, 1, {0, 0, 0});
-    const Grid grid = voxelizeDims(scene, dims);
+    const Grid grid = voxelizeWith(scene, dims);
     const Accel a = buildAccel(scene, grid, AccelKind::Grid);
     if (a.blockShift == 0) continue;
     expectBoxesValidAndMaximal(a, checked);
@@ -108,7 +104,7 @@ TEST(CellBoxes, JumpingWalkEqualsBruteForceAtEveryScale) {
       const Vec3 off{offset * (scale >= 1 ? scale : 1), -offset, offset};
       const Scene scene = scatteredTriangles(rng, 8, scale, off);
       const std::array<uint32_t, 3> dims{20, 17, 23};
-      const Grid grid = voxelizeDims(scene, dims);
+      const Grid grid = voxelizeWith(scene, dims);
       const Accel jump = buildAccel(scene, grid, AccelKind::Grid);
       const Accel uniform = buildAccel(scene, grid, AccelKind::Uniform);
       const Accel brute = buildAccel(scene, grid, AccelKind::None);

@@ -19,13 +19,9 @@
 namespace vox {
 namespace {
 
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;  // the sanitizer build runs the same checks on smaller grids
-#else
-constexpr bool kSanitized = false;
-#endif
+using testing::kSanitized;
 
-std::string seed(const std::string& rel) { return std::string(VOX_SEED_DIR) + "/" + rel; }
+using testing::seed;
 
 std::vector<uint8_t> solidMask(const Grid& g) {
   std::vector<uint8_t> mask(g.cellCount(), 0);

@@ -10,6 +10,7 @@
 #include <random>
 
 #include "trace/float_filter.h"
+#include "render_util.h"
 #include "vox/trace/accel.h"
 #include "vox/trace/intersect.h"
 #include "vox/trace/traverse.h"
@@ -17,6 +18,8 @@
 
 namespace vox {
 namespace {
+
+using testing::voxelizeWith;
 
 // A scene of `count` random triangles in the box [offset, offset + scale]^3, some of them long slivers, some
 // sharing vertices and edges (fans), so that rays through shared edges meet two triangles at once.
@@ -32,12 +35,6 @@ Scene randomScene(std::mt19937_64& rng, int count, double scale, const Vec3& off
     scene.triangles.push_back(t);
   }
   return scene;
-}
-
-Grid voxelizeDims(const Scene& scene, std::array<uint32_t, 3> dims) {
-  VoxelizeOptions o;
-  o.dims = dims;
-  return voxelizeScene(scene, o);
 }
 
 // Rays aimed at the filter's weak spots of the scene's triangles: at vertices, at points of edges (exact and 1 ulp
@@ -125,7 +122,7 @@ TEST(FloatFilter, NeverRejectsADoubleHit) {
   for (double scale : scales)
     for (const Vec3& off : offsets) {
       const Scene scene = randomScene(rng, 60, scale, off * scale);
-      const Grid grid = voxelizeDims(scene, {5, 4, 6});
+      const Grid grid = voxelizeWith(scene, {5, 4, 6});
       const Accel accel = buildAccel(scene, grid, AccelKind::Grid);
       ASSERT_TRUE(accel.floatCells.enabled) << "scale " << scale;
       uint64_t rejected = 0, lanes = 0;
@@ -140,7 +137,7 @@ TEST(FloatFilter, NeverRejectsADoubleHit) {
 TEST(FloatFilter, FarFromTheOrigin) {
   std::mt19937_64 rng(7);
   const Scene scene = randomScene(rng, 50, 1e-3, Vec3{1e12, -3e12, 7e11});
-  const Grid grid = voxelizeDims(scene, {4, 4, 4});
+  const Grid grid = voxelizeWith(scene, {4, 4, 4});
   const Accel accel = buildAccel(scene, grid, AccelKind::Grid);
   ASSERT_TRUE(accel.floatCells.enabled);
   uint64_t rejected = 0, lanes = 0;
@@ -158,7 +155,7 @@ TEST(FloatFilter, WalksEqualDoubleOnlyAndBruteForce) {
   std::mt19937_64 rng(99);
   for (double scale : {1e-6, 1.0, 1e6}) {
     const Scene scene = randomScene(rng, 200, scale, Vec3{3, -1, 2} * scale);
-    const Grid grid = voxelizeDims(scene, {9, 7, 8});
+    const Grid grid = voxelizeWith(scene, {9, 7, 8});
     const Accel filtered = buildAccel(scene, grid, AccelKind::Grid);
     Accel doubleOnly = buildAccel(scene, grid, AccelKind::Grid);
     doubleOnly.floatCells = {};
@@ -195,7 +192,7 @@ TEST(FloatFilter, OffOutsideItsRange) {
   Scene scene;
   scene.materials.push_back({});
   scene.triangles.push_back(Triangle{{Vec3{0, 0, 0}, Vec3{1e-80, 0, 0}, Vec3{0, 1e-80, 0}}});
-  const Grid grid = voxelizeDims(scene, {2, 2, 1});
+  const Grid grid = voxelizeWith(scene, {2, 2, 1});
   const Accel accel = buildAccel(scene, grid, AccelKind::Grid);
   EXPECT_FALSE(accel.floatCells.enabled);
   const Hit h = traceRay(accel, Ray{{2e-81, 2e-81, 1}, {0, 0, -1}, 0, kInfinity});

@@ -5,6 +5,7 @@
 
 #include <cstring>
 
+#include "grid_file_util.h"
 #include "test_util.h"
 #include "vox/core/error.h"
 #include "vox/io/grid_file.h"
@@ -15,9 +16,12 @@
 namespace vox {
 namespace {
 
+using testing::resealed;
+using testing::smallGrid;
+
 constexpr size_t kSectionBytes = 4 + 8 + 1;  // tag, size, span
 
-Scene courseScene(CameraKind kind) {
+Scene cameraScene(CameraKind kind) {
   Scene s = testing::randomScene(7, 6, 2);
   Camera c;
   c.kind = kind;
@@ -30,19 +34,7 @@ Scene courseScene(CameraKind kind) {
   return s;
 }
 
-Grid gridOf(const Scene& s) {
-  VoxelizeOptions o;
-  o.dims = {3, 3, 3};
-  return voxelizeScene(s, o);
-}
 
-std::string resealed(std::string m) {
-  const uint64_t size = m.size() - 32;
-  std::memcpy(&m[16], &size, 8);
-  const uint64_t sum = gridChecksum(m.data() + 32, size);
-  std::memcpy(&m[24], &sum, 8);
-  return m;
-}
 
 std::string section(uint8_t span, uint64_t size = 1) {
   std::string out(kSectionBytes, '\0');
@@ -55,8 +47,8 @@ std::string section(uint8_t span, uint64_t size = 1) {
 
 TEST(GridSectionCamera, CourseCamerasKeepTheirSpanAndFraming) {
   for (CameraKind kind : {CameraKind::Perspective, CameraKind::Orthographic}) {
-    const Scene s = courseScene(kind);
-    const Grid g = gridOf(s);
+    const Scene s = cameraScene(kind);
+    const Grid g = smallGrid(s, 3);
     const std::string bytes = encodeGridFile(s, g);
     EXPECT_EQ(bytes.substr(bytes.size() - kSectionBytes), section(1));  // the last section written
     const GridFile f = decodeGridFile(bytes, "t.vgrid");
@@ -82,8 +74,8 @@ TEST(GridSectionCamera, CourseCamerasKeepTheirSpanAndFraming) {
 }
 
 TEST(GridSectionCamera, EveryTruncationAndBitFlipIsRefused) {
-  const Scene s = courseScene(CameraKind::Perspective);
-  const std::string bytes = encodeGridFile(s, gridOf(s));
+  const Scene s = cameraScene(CameraKind::Perspective);
+  const std::string bytes = encodeGridFile(s, smallGrid(s, 3));
   for (size_t n = bytes.size() - kSectionBytes; n < bytes.size(); ++n)
     EXPECT_THROW(decodeGridFile(bytes.substr(0, n), "cut.vgrid"), InputError) << n;
   for (size_t bit = (bytes.size() - kSectionBytes) * 8; bit < bytes.size() * 8; ++bit) {
@@ -94,8 +86,8 @@ TEST(GridSectionCamera, EveryTruncationAndBitFlipIsRefused) {
 }
 
 TEST(GridSectionCamera, HostileBodiesWithAValidChecksumAreRefused) {
-  const Scene s = courseScene(CameraKind::Perspective);
-  const Grid g = gridOf(s);
+  const Scene s = cameraScene(CameraKind::Perspective);
+  const Grid g = smallGrid(s, 3);
   const std::string bytes = encodeGridFile(s, g);
   const std::string head = bytes.substr(0, bytes.size() - kSectionBytes);
   const auto refused = [](const std::string& m, const char* what) {

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <random>
 
+#include "grid_file_util.h"
 #include "test_util.h"
 #include "vox/core/error.h"
 #include "vox/import/import.h"
@@ -19,9 +20,12 @@
 namespace vox {
 namespace {
 
+using testing::resealed;
+using testing::smallGrid;
+
 constexpr size_t kTextureBytes = 1 + 16 * 8 + 4 + 4 + 4 + 8 + 8;
 
-Scene texturedScene() {
+Scene solidTexturedScene() {
   Scene s = testing::randomScene(4, 5, 2);
   Material red, blue;
   red.diffuse = {1, 0, 0};
@@ -45,11 +49,6 @@ Scene texturedScene() {
   return s;
 }
 
-Grid gridOf(const Scene& s) {
-  VoxelizeOptions o;
-  o.dims = {3, 3, 3};
-  return voxelizeScene(s, o);
-}
 
 // Offset of the section body: it is written last, and its size follows from its counts.
 size_t bodyOffset(const Scene& s) {
@@ -58,17 +57,10 @@ size_t bodyOffset(const Scene& s) {
   return 8 + s.solidTextures.size() * kTextureBytes + 8 + textured * 8;
 }
 
-std::string resealed(std::string m) {
-  const uint64_t size = m.size() - 32;
-  std::memcpy(&m[16], &size, 8);
-  const uint64_t sum = gridChecksum(m.data() + 32, size);
-  std::memcpy(&m[24], &sum, 8);
-  return m;
-}
 
 TEST(GridSectionSolidTextures, RoundTripIsExactAndRendersTheSame) {
-  const Scene s = texturedScene();
-  const Grid g = gridOf(s);
+  const Scene s = solidTexturedScene();
+  const Grid g = smallGrid(s, 3);
   const GridFile f = decodeGridFile(encodeGridFile(s, g), "t.vgrid");
   ASSERT_EQ(f.scene.solidTextures.size(), s.solidTextures.size());
   for (size_t i = 0; i < s.solidTextures.size(); ++i) {
@@ -98,8 +90,8 @@ TEST(GridSectionSolidTextures, RoundTripIsExactAndRendersTheSame) {
 }
 
 TEST(GridSectionSolidTextures, EveryTruncationAndBitFlipIsRefused) {
-  const Scene s = texturedScene();
-  const std::string bytes = encodeGridFile(s, gridOf(s));
+  const Scene s = solidTexturedScene();
+  const std::string bytes = encodeGridFile(s, smallGrid(s, 3));
   // Only the section's own bytes and its header: the rest of the file is the general test's.
   for (size_t n = bytes.size() - bodyOffset(s) - 12; n < bytes.size(); ++n)
     EXPECT_THROW(decodeGridFile(bytes.substr(0, n), "cut.vgrid"), InputError) << n;
@@ -111,8 +103,8 @@ TEST(GridSectionSolidTextures, EveryTruncationAndBitFlipIsRefused) {
 }
 
 TEST(GridSectionSolidTextures, HostileBodiesWithAValidChecksumAreRefused) {
-  const Scene s = texturedScene();
-  const std::string bytes = encodeGridFile(s, gridOf(s));
+  const Scene s = solidTexturedScene();
+  const std::string bytes = encodeGridFile(s, smallGrid(s, 3));
   const size_t body = bytes.size() - bodyOffset(s);
   const size_t tex1 = body + 8 + kTextureBytes;  // the Wood texture
   const size_t pairs = body + 8 + 2 * kTextureBytes + 8;
@@ -166,12 +158,12 @@ TEST(GridSectionSolidTextures, HostileBodiesWithAValidChecksumAreRefused) {
     deep.materials.push_back(m);
   }
   deep.triangles.push_back(Triangle{{Vec3{0, 0, 0}, Vec3{1, 0, 0}, Vec3{0, 1, 0}}, 0});
-  refused(encodeGridFile(deep, gridOf(deep)), "nesting too deep");
+  refused(encodeGridFile(deep, smallGrid(deep, 3)), "nesting too deep");
 }
 
 TEST(GridSectionSolidTextures, MutationsWithValidChecksumDecodeOrThrow) {
-  const Scene s = texturedScene();
-  const std::string bytes = encodeGridFile(s, gridOf(s));
+  const Scene s = solidTexturedScene();
+  const std::string bytes = encodeGridFile(s, smallGrid(s, 3));
   const size_t body = bytes.size() - bodyOffset(s);
   std::mt19937 rng(29);
   int accepted = 0;

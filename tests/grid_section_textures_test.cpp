@@ -8,12 +8,16 @@
 #include <cstring>
 #include <limits>
 
+#include "grid_file_util.h"
 #include "vox/core/error.h"
 #include "vox/io/grid_file.h"
 #include "vox/voxelize/voxelize.h"
 
 namespace vox {
 namespace {
+
+using testing::resealed;
+using testing::smallGrid;
 
 constexpr size_t kHeader = 32;
 
@@ -38,18 +42,7 @@ Scene texturedScene() {
   return scene;
 }
 
-Grid gridOf(const Scene& scene) {
-  VoxelizeOptions options;
-  options.dims = std::array<uint32_t, 3>{2, 2, 2};
-  return voxelizeScene(scene, options);
-}
 
-// `bytes` with its header checksum recomputed after a patch.
-std::string resealed(std::string bytes) {
-  const uint64_t sum = gridChecksum(bytes.data() + kHeader, bytes.size() - kHeader);
-  std::memcpy(bytes.data() + 24, &sum, 8);
-  return bytes;
-}
 
 template <typename T>
 std::string patched(const std::string& bytes, size_t at, T value) {
@@ -58,7 +51,7 @@ std::string patched(const std::string& bytes, size_t at, T value) {
   return resealed(out);
 }
 
-void expectRefused(const std::string& bytes, const std::string& what) {
+void expectSectionRefused(const std::string& bytes, const std::string& what) {
   try {
     decodeGridFile(bytes, "t.vgrid");
     ADD_FAILURE() << what << ": accepted";
@@ -69,7 +62,7 @@ void expectRefused(const std::string& bytes, const std::string& what) {
 
 TEST(GridSectionTextures, RoundTripsBitForBit) {
   const Scene scene = texturedScene();
-  const GridFile back = decodeGridFile(encodeGridFile(scene, gridOf(scene)), "t.vgrid");
+  const GridFile back = decodeGridFile(encodeGridFile(scene, smallGrid(scene, 2)), "t.vgrid");
   ASSERT_EQ(back.scene.textures.size(), 1u);
   const Texture& t = back.scene.textures[0];
   EXPECT_EQ(t.name, "TEXNAME");
@@ -89,11 +82,11 @@ TEST(GridSectionTextures, RoundTripsBitForBit) {
 
 TEST(GridSectionTextures, NoTexturesNoSection) {
   Scene scene = texturedScene();
-  const size_t withTextures = encodeGridFile(scene, gridOf(scene)).size();
+  const size_t withTextures = encodeGridFile(scene, smallGrid(scene, 2)).size();
   scene.textures.clear();
   scene.materials[1].diffuseTexture = kNoTexture;
   scene.triangleUVs.clear();
-  const std::string plain = encodeGridFile(scene, gridOf(scene));
+  const std::string plain = encodeGridFile(scene, smallGrid(scene, 2));
   EXPECT_EQ(plain.find("TEXNAME"), std::string::npos);
   EXPECT_LT(plain.size(), withTextures);
   EXPECT_TRUE(decodeGridFile(plain, "t.vgrid").scene.textures.empty());
@@ -101,7 +94,7 @@ TEST(GridSectionTextures, NoTexturesNoSection) {
 
 TEST(GridSectionTextures, EveryFieldIsChecked) {
   const Scene scene = texturedScene();
-  const std::string good = encodeGridFile(scene, gridOf(scene));
+  const std::string good = encodeGridFile(scene, smallGrid(scene, 2));
   // Body layout (docs/grid-format.md): u64 T | u32 len "TEXNAME" | u32 w | u32
   // h | u8 wrapU | u8 wrapV | u64 n | n texel bytes | u64 M | (u32 material,
   // u32 texture) * M | u64 N | 6 doubles * N.
@@ -114,23 +107,23 @@ TEST(GridSectionTextures, EveryFieldIsChecked) {
   ASSERT_EQ(firstUv + 2 * 6 * 8, good.size());
   EXPECT_NO_THROW(decodeGridFile(resealed(good), "t.vgrid"));
 
-  expectRefused(patched(good, body, uint64_t(0)), "no textures");
-  expectRefused(patched(good, body, uint64_t(2)), "two textures");
-  expectRefused(patched(good, body, std::numeric_limits<uint64_t>::max()), "absurd texture count");
-  expectRefused(patched(good, w, uint32_t(0)), "zero width");
-  expectRefused(patched(good, w, uint32_t(3)), "width not matching the texels");
-  expectRefused(patched(good, h, uint32_t(kMaxTextureSide + 1)), "too tall");
-  expectRefused(patched(good, wrapU, uint8_t(3)), "unknown wrap");
-  expectRefused(patched(good, wrapV, uint8_t(255)), "unknown wrap");
-  expectRefused(patched(good, texels, uint64_t(5)), "texel count");
-  expectRefused(patched(good, texels, uint64_t(1) << 60), "absurd texel count");
-  expectRefused(patched(good, pairs, uint64_t(2)), "material pairs past the body");
-  expectRefused(patched(good, material, uint32_t(2)), "material out of range");
-  expectRefused(patched(good, texture, uint32_t(1)), "texture out of range");
-  expectRefused(patched(good, uvCount, uint64_t(1)), "coordinates not one per triangle");
-  expectRefused(patched(good, uvCount, uint64_t(3)), "coordinates past the body");
-  expectRefused(patched(good, firstUv + 8, std::numeric_limits<double>::quiet_NaN()), "NaN coordinate");
-  expectRefused(patched(good, firstUv, std::numeric_limits<double>::infinity()), "infinite coordinate");
+  expectSectionRefused(patched(good, body, uint64_t(0)), "no textures");
+  expectSectionRefused(patched(good, body, uint64_t(2)), "two textures");
+  expectSectionRefused(patched(good, body, std::numeric_limits<uint64_t>::max()), "absurd texture count");
+  expectSectionRefused(patched(good, w, uint32_t(0)), "zero width");
+  expectSectionRefused(patched(good, w, uint32_t(3)), "width not matching the texels");
+  expectSectionRefused(patched(good, h, uint32_t(kMaxTextureSide + 1)), "too tall");
+  expectSectionRefused(patched(good, wrapU, uint8_t(3)), "unknown wrap");
+  expectSectionRefused(patched(good, wrapV, uint8_t(255)), "unknown wrap");
+  expectSectionRefused(patched(good, texels, uint64_t(5)), "texel count");
+  expectSectionRefused(patched(good, texels, uint64_t(1) << 60), "absurd texel count");
+  expectSectionRefused(patched(good, pairs, uint64_t(2)), "material pairs past the body");
+  expectSectionRefused(patched(good, material, uint32_t(2)), "material out of range");
+  expectSectionRefused(patched(good, texture, uint32_t(1)), "texture out of range");
+  expectSectionRefused(patched(good, uvCount, uint64_t(1)), "coordinates not one per triangle");
+  expectSectionRefused(patched(good, uvCount, uint64_t(3)), "coordinates past the body");
+  expectSectionRefused(patched(good, firstUv + 8, std::numeric_limits<double>::quiet_NaN()), "NaN coordinate");
+  expectSectionRefused(patched(good, firstUv, std::numeric_limits<double>::infinity()), "infinite coordinate");
   // Cut anywhere inside the section (header and checksum made consistent):
   // refused, never a crash. (Cut right before its tag, the file simply has no
   // section.)
@@ -138,7 +131,7 @@ TEST(GridSectionTextures, EveryFieldIsChecked) {
     std::string bytes = good.substr(0, cut);
     const uint64_t payload = bytes.size() - kHeader;
     std::memcpy(bytes.data() + 16, &payload, 8);
-    expectRefused(resealed(bytes), "cut at " + std::to_string(cut));
+    expectSectionRefused(resealed(bytes), "cut at " + std::to_string(cut));
   }
 }
 

@@ -21,14 +21,16 @@
 #include <string>
 #include <vector>
 
+#include "test_util.h"
 #include "vox/core/error.h"
 
 namespace vox {
 namespace {
 
+using testing::seed;
+
 namespace fs = std::filesystem;
 
-std::string seed(const std::string& rel) { return std::string(VOX_SEED_DIR) + "/" + rel; }
 std::string course(const std::string& name) { return seed("6837/scenes/" + name); }
 
 // A fresh directory per test, removed afterwards.

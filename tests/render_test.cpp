@@ -10,6 +10,7 @@
 #include <random>
 
 #include "seed_cases.h"
+#include "render_util.h"
 #include "test_util.h"
 #include "vox/trace/accel.h"
 #include "vox/core/error.h"
@@ -21,30 +22,9 @@
 namespace vox {
 namespace {
 
-Grid voxelize(const Scene& scene, std::array<uint32_t, 3> dims, OverlapMethod method) {
-  VoxelizeOptions o;
-  o.dims = dims;
-  o.method = method;
-  return voxelizeScene(scene, o);
-}
-
-Image render(const Scene& scene, const Grid& grid, AccelKind kind, RenderOptions ro, RenderStats* st = nullptr) {
-  const Accel accel = buildAccel(scene, grid, kind);
-  return traceImage(scene, accel, ro, st);
-}
-
-// Number of pixels whose values differ at all (bitwise on the float values).
-int differingPixels(const Image& a, const Image& b) {
-  EXPECT_EQ(a.pixels.size(), b.pixels.size());
-  int count = 0;
-  for (size_t p = 0; p + a.channels <= a.pixels.size(); p += a.channels) {
-    bool same = true;
-    for (uint32_t c = 0; c < a.channels; ++c)
-      same &= std::memcmp(&a.pixels[p + c], &b.pixels[p + c], sizeof(float)) == 0;
-    count += !same;
-  }
-  return count;
-}
+using testing::differingPixels;
+using testing::renderWith;
+using testing::voxelizeWith;
 
 int nonBackgroundPixels(const Image& image, const Vec3& background) {
   int count = 0;
@@ -70,10 +50,10 @@ TEST_P(SeedScene, GridAndBruteForceImagesAreIdentical) {
   ro.height = std::string(c.file).find("6.837") != std::string::npos ? ro.width / 2 : ro.width;
   ro.camera = scene.camera ? *scene.camera : defaultCamera(*sceneBounds(scene));
   for (OverlapMethod m : {OverlapMethod::Exact, OverlapMethod::Sat, OverlapMethod::BBox, OverlapMethod::Center}) {
-    const Grid grid = voxelize(scene, c.dims, m);
+    const Grid grid = voxelizeWith(scene, c.dims, m);
     RenderStats gs;
-    const Image g = render(scene, grid, AccelKind::Grid, ro, &gs);
-    const Image n = render(scene, grid, AccelKind::None, ro);
+    const Image g = renderWith(scene, grid, AccelKind::Grid, ro, &gs);
+    const Image n = renderWith(scene, grid, AccelKind::None, ro);
     const int differ = differingPixels(g, n);
     if (m == OverlapMethod::Center) {
       RecordProperty(std::string("center_differing_pixels_") + c.file, differ);
@@ -125,8 +105,8 @@ TEST(RenderGridVsBruteForce, RandomScenesAndCamerasInsideAndOutside) {
       ro.camera.fovDegrees = 50;
       ro.camera.orthoHeight = 2.5;
       for (OverlapMethod m : {OverlapMethod::Exact, OverlapMethod::Sat, OverlapMethod::BBox}) {
-        const Grid grid = voxelize(scene, {dim(rng), dim(rng), dim(rng)}, m);
-        EXPECT_EQ(differingPixels(render(scene, grid, AccelKind::Grid, ro), render(scene, grid, AccelKind::None, ro)),
+        const Grid grid = voxelizeWith(scene, {dim(rng), dim(rng), dim(rng)}, m);
+        EXPECT_EQ(differingPixels(renderWith(scene, grid, AccelKind::Grid, ro), renderWith(scene, grid, AccelKind::None, ro)),
                   0)
             << "seed " << seed << " camera " << cam << " " << methodName(m);
         ++checked;
@@ -222,7 +202,7 @@ Scene planeScene() {
 
 TEST(RenderModes, DepthNormalsCountShade) {
   const Scene scene = planeScene();
-  const Grid grid = voxelize(scene, {4, 4, 1}, OverlapMethod::Exact);
+  const Grid grid = voxelizeWith(scene, {4, 4, 1}, OverlapMethod::Exact);
   RenderOptions ro;
   ro.width = ro.height = 9;
   ro.camera.center = {0, 0, 5};
@@ -230,7 +210,7 @@ TEST(RenderModes, DepthNormalsCountShade) {
   ro.camera.fovDegrees = 60;  // the square fills the middle
   ro.mode = RenderMode::Depth;
   RenderStats st;
-  const Image depth = render(scene, grid, AccelKind::Grid, ro, &st);
+  const Image depth = renderWith(scene, grid, AccelKind::Grid, ro, &st);
   ASSERT_EQ(depth.channels, 1u);
   EXPECT_FLOAT_EQ(depth.at(4, 4)[0], 5.0f);  // centre: straight down
   EXPECT_EQ(depth.at(0, 0)[0], 0.0f);        // corner: misses (tan 30 * 5 = 2.9 > 1)
@@ -244,24 +224,24 @@ TEST(RenderModes, DepthNormalsCountShade) {
   EXPECT_LT(grey.at(5, 3)[0], 1.0f);
 
   ro.mode = RenderMode::Normals;  // (n + 1) / 2 of the normal facing the viewer: +z -> (0.5, 0.5, 1)
-  const Image normals = render(scene, grid, AccelKind::Grid, ro);
+  const Image normals = renderWith(scene, grid, AccelKind::Grid, ro);
   EXPECT_FLOAT_EQ(normals.at(4, 4)[2], 1.0f);
   EXPECT_FLOAT_EQ(normals.at(4, 4)[0], 0.5f);
   ro.camera.center = {0, 0, -5};  // from below: the normal turns to -z
   ro.camera.direction = {0, 0, 1};
-  EXPECT_FLOAT_EQ(render(scene, grid, AccelKind::Grid, ro).at(4, 4)[2], 0.0f);
+  EXPECT_FLOAT_EQ(renderWith(scene, grid, AccelKind::Grid, ro).at(4, 4)[2], 0.0f);
 
   ro.mode = RenderMode::Count;
-  const Image count = render(scene, grid, AccelKind::Grid, ro, &st);
+  const Image count = renderWith(scene, grid, AccelKind::Grid, ro, &st);
   EXPECT_GE(st.countMax, 1.0);
   EXPECT_EQ(count.channels, 3u);
 
   // Shade without lights, from below (the camera of the normals check): the square shows its back, black without
   // shadeBack as in the course; with it the headlight straight down the view gives diffuse 1 at the centre.
   ro.mode = RenderMode::Shade;
-  EXPECT_FLOAT_EQ(render(scene, grid, AccelKind::Grid, ro).at(4, 4)[0], 0.0f);
+  EXPECT_FLOAT_EQ(renderWith(scene, grid, AccelKind::Grid, ro).at(4, 4)[0], 0.0f);
   ro.shadeBack = true;
-  const Image shade = render(scene, grid, AccelKind::Grid, ro);
+  const Image shade = renderWith(scene, grid, AccelKind::Grid, ro);
   EXPECT_FLOAT_EQ(shade.at(4, 4)[0], 1.0f);
   EXPECT_FLOAT_EQ(shade.at(0, 0)[2], 0.3f);
 }
@@ -272,14 +252,14 @@ TEST(RenderModes, ShadowRaysDarkenWhatIsBehindAnOccluder) {
   scene.triangles.push_back(Triangle{{Vec3{-0.3, -0.3, 1}, Vec3{0.3, -0.3, 1}, Vec3{0.3, 0.3, 1}}});
   scene.triangles.push_back(Triangle{{Vec3{-0.3, -0.3, 1}, Vec3{0.3, 0.3, 1}, Vec3{-0.3, 0.3, 1}}});
   scene.lights.push_back(Light{LightKind::Directional, {0, 0, -1}, {}, {1, 1, 1}, {1, 0, 0}});
-  const Grid grid = voxelize(scene, {5, 5, 5}, OverlapMethod::Exact);
+  const Grid grid = voxelizeWith(scene, {5, 5, 5}, OverlapMethod::Exact);
   RenderOptions ro;
   ro.width = ro.height = 21;
   ro.camera.center = {0, -6, 3};
   ro.camera.direction = Vec3{0, 0, 0.2} - ro.camera.center;
   ro.camera.fovDegrees = 30;
   RenderStats st;
-  const Image img = render(scene, grid, AccelKind::Grid, ro, &st);
+  const Image img = renderWith(scene, grid, AccelKind::Grid, ro, &st);
   EXPECT_GT(st.trace.rays, uint64_t(ro.width) * ro.height);  // shadow rays were traced
   // Some floor pixels are in shadow (0) and some lit (1).
   int lit = 0, dark = 0;
@@ -289,12 +269,12 @@ TEST(RenderModes, ShadowRaysDarkenWhatIsBehindAnOccluder) {
   }
   EXPECT_GT(lit, 10);
   EXPECT_GT(dark, 0);
-  EXPECT_EQ(differingPixels(img, render(scene, grid, AccelKind::None, ro)), 0);
+  EXPECT_EQ(differingPixels(img, renderWith(scene, grid, AccelKind::None, ro)), 0);
 }
 
 TEST(RenderDeterminism, ThreadCountAndRepeatsDoNotChangeTheImage) {
   const Scene scene = testing::randomScene(9, 80, 4);
-  const Grid grid = voxelize(scene, {8, 8, 8}, OverlapMethod::Exact);
+  const Grid grid = voxelizeWith(scene, {8, 8, 8}, OverlapMethod::Exact);
   RenderOptions ro;
   ro.width = 37;
   ro.height = 23;
@@ -303,11 +283,11 @@ TEST(RenderDeterminism, ThreadCountAndRepeatsDoNotChangeTheImage) {
   Image one;
   {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
-    one = render(scene, grid, AccelKind::Grid, ro);
+    one = renderWith(scene, grid, AccelKind::Grid, ro);
   }
-  EXPECT_EQ(differingPixels(one, render(scene, grid, AccelKind::Grid, ro)), 0);
+  EXPECT_EQ(differingPixels(one, renderWith(scene, grid, AccelKind::Grid, ro)), 0);
   ro.seed = 1;  // another jitter seed gives another (antialiased) image
-  EXPECT_GT(differingPixels(one, render(scene, grid, AccelKind::Grid, ro)), 0);
+  EXPECT_GT(differingPixels(one, renderWith(scene, grid, AccelKind::Grid, ro)), 0);
 }
 
 TEST(RenderModes, VoxelsDrawOccupiedCellsOnly) {
@@ -317,7 +297,7 @@ TEST(RenderModes, VoxelsDrawOccupiedCellsOnly) {
   s.radius = 1;
   scene.spheres.push_back(s);
   scene.background = {0, 0, 0};
-  const Grid grid = voxelize(scene, {1, 1, 1}, OverlapMethod::Exact);
+  const Grid grid = voxelizeWith(scene, {1, 1, 1}, OverlapMethod::Exact);
   RenderOptions ro;
   ro.width = ro.height = 20;
   ro.mode = RenderMode::Voxels;
@@ -326,7 +306,7 @@ TEST(RenderModes, VoxelsDrawOccupiedCellsOnly) {
   ro.camera.kind = CameraKind::Orthographic;
   ro.camera.orthoHeight = 4;
   // A 1x1x1 grid fills the bounding box [-1, 1]^3: exactly the middle half of the image is drawn, as a square.
-  const Image img = render(scene, grid, AccelKind::Grid, ro);
+  const Image img = renderWith(scene, grid, AccelKind::Grid, ro);
   for (uint32_t y = 0; y < 20; ++y)
     for (uint32_t x = 0; x < 20; ++x) {
       const bool inside = x >= 5 && x < 15 && y >= 5 && y < 15;

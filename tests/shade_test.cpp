@@ -10,6 +10,7 @@
 #include <iterator>
 #include <random>
 
+#include "render_util.h"
 #include "test_util.h"
 #include "trace/shade.h"
 #include "vox/import/import.h"
@@ -20,33 +21,11 @@
 namespace vox {
 namespace {
 
-Grid voxelize(const Scene& scene, std::array<uint32_t, 3> dims, OverlapMethod method = OverlapMethod::Exact) {
-  VoxelizeOptions o;
-  o.dims = dims;
-  o.method = method;
-  return voxelizeScene(scene, o);
-}
+using testing::kSanitized;
 
-Image render(const Scene& scene, const Grid& grid, AccelKind kind, const RenderOptions& ro, RenderStats* st = nullptr) {
-  const Accel accel = buildAccel(scene, grid, kind);
-  return traceImage(scene, accel, ro, st);
-}
-
-int differingPixels(const Image& a, const Image& b) {
-  EXPECT_EQ(a.pixels.size(), b.pixels.size());
-  int count = 0;
-  for (size_t p = 0; p + a.channels <= a.pixels.size() && p + a.channels <= b.pixels.size(); p += a.channels)
-    count += std::memcmp(&a.pixels[p], &b.pixels[p], a.channels * sizeof(float)) != 0;
-  return count;
-}
-
-// Whether the sanitizers are on (the CI's second run): the tests then trace smaller images.
-constexpr bool kSanitized =
-#if defined(__SANITIZE_ADDRESS__)
-    true;
-#else
-    false;
-#endif
+using testing::differingPixels;
+using testing::renderWith;
+using testing::voxelizeWith;
 
 Material phong(Vec3 diffuse, Vec3 reflective = {}, Vec3 transparent = {}, double ior = 1) {
   Material m;
@@ -106,12 +85,12 @@ TEST(ShadeReflection, MirrorAt45DegreesShowsTheObjectItFaces) {
   s.background = {0, 0, 0.25};
   addQuad(s, {-3, -3, 3}, {3, -3, -3}, {3, 3, -3}, {-3, 3, 3}, 0);  // the mirror, normal (1, 0, 1) / sqrt 2
   addQuad(s, {3, -0.5, -0.5}, {3, -0.5, 0.5}, {3, 0.5, 0.5}, {3, 0.5, -0.5}, 1);  // red, facing -x
-  const Grid grid = voxelize(s, {6, 4, 6});
+  const Grid grid = voxelizeWith(s, {6, 4, 6});
   RenderOptions ro;
   ro.width = ro.height = 41;
   ro.camera = ortho({0, 0, 5}, {0, 0, -1}, 4.1);  // pixel (x, y) at u = (x - 20) * 0.1, v = (20 - y) * 0.1
   ro.bounces = 1;
-  const Image img = render(s, grid, AccelKind::Grid, ro);
+  const Image img = renderWith(s, grid, AccelKind::Grid, ro);
   for (uint32_t y = 0; y < 41; ++y)
     for (uint32_t x = 0; x < 41; ++x) {
       const double u = (double(x) - 20) * 0.1, v = (20 - double(y)) * 0.1;
@@ -124,12 +103,12 @@ TEST(ShadeReflection, MirrorAt45DegreesShowsTheObjectItFaces) {
         EXPECT_FLOAT_EQ(p[2], 0.125f);
       }
     }
-  EXPECT_EQ(differingPixels(img, render(s, grid, AccelKind::None, ro)), 0);
+  EXPECT_EQ(differingPixels(img, renderWith(s, grid, AccelKind::None, ro)), 0);
   ro.bounces = 0;  // no reflection: the mirror's own (black) colour
-  EXPECT_FLOAT_EQ(render(s, grid, AccelKind::Grid, ro).at(20, 20)[0], 0.0f);
+  EXPECT_FLOAT_EQ(renderWith(s, grid, AccelKind::Grid, ro).at(20, 20)[0], 0.0f);
   ro.bounces = 1;
   ro.weight = 0.6;  // the reflected path weighs 0.5: cut
-  EXPECT_FLOAT_EQ(render(s, grid, AccelKind::Grid, ro).at(20, 20)[0], 0.0f);
+  EXPECT_FLOAT_EQ(renderWith(s, grid, AccelKind::Grid, ro).at(20, 20)[0], 0.0f);
 }
 
 // A glass slab of thickness h and index n shifts what is behind it by h sin(a - b) / cos b across the rays, with
@@ -153,7 +132,7 @@ SlabScene slabScene(bool withSlab, double h, double ior) {
     s.planes.push_back(Plane{{0, 0, 1}, 0, 2});   // top face z = 0, normal up
     s.planes.push_back(Plane{{0, 0, -1}, h, 2});  // bottom face z = -h, normal down (outward)
   }
-  out.grid = voxelize(s, {4, 4, 1});
+  out.grid = voxelizeWith(s, {4, 4, 1});
   return out;
 }
 
@@ -180,15 +159,15 @@ TEST(ShadeRefraction, GlassSlabShiftsALineBySnellsLaw) {
   ro.bounces = 2;
   ro.shadeBack = true;
   const SlabScene plain = slabScene(false, h, ior), glass = slabScene(true, h, ior);
-  const double u0 = lineCentre(render(plain.scene, plain.grid, AccelKind::Grid, ro), size);
-  const Image through = render(glass.scene, glass.grid, AccelKind::Grid, ro);
+  const double u0 = lineCentre(renderWith(plain.scene, plain.grid, AccelKind::Grid, ro), size);
+  const Image through = renderWith(glass.scene, glass.grid, AccelKind::Grid, ro);
   const double u1 = lineCentre(through, size);
   EXPECT_NEAR(u1 - u0, shift, 2 * size) << "without the slab at " << u0 << ", with it at " << u1;
-  EXPECT_EQ(differingPixels(through, render(glass.scene, glass.grid, AccelKind::None, ro)), 0);
+  EXPECT_EQ(differingPixels(through, renderWith(glass.scene, glass.grid, AccelKind::None, ro)), 0);
   // A ray that reaches the bounce limit stops: with one bounce the ray inside the slab is not continued, so the
   // line disappears and the slab is black.
   ro.bounces = 1;
-  const Image stopped = render(glass.scene, glass.grid, AccelKind::Grid, ro);
+  const Image stopped = renderWith(glass.scene, glass.grid, AccelKind::Grid, ro);
   for (uint32_t x = 0; x < stopped.width; ++x) EXPECT_EQ(stopped.at(x, 0)[0], 0.0f) << x;
 }
 
@@ -202,7 +181,7 @@ TEST(ShadeRefraction, TotalInternalReflectionBeyondTheCriticalAngle) {
   s.planes.push_back(Plane{{0, 0, 1}, 0, 0});    // the glass surface z = 0; glass below, air above
   s.planes.push_back(Plane{{0, 0, -1}, -1, 1});  // red ceiling z = 1, facing down
   s.planes.push_back(Plane{{0, 0, 1}, -5, 2});   // green floor z = -5, inside the glass
-  const Grid grid = voxelize(s, {1, 1, 1});
+  const Grid grid = voxelizeWith(s, {1, 1, 1});
   for (double deg : {0.0, 30.0, 41.0, 42.5, 60.0, 80.0}) {
     const double a = deg * M_PI / 180;
     RenderOptions ro;
@@ -210,7 +189,7 @@ TEST(ShadeRefraction, TotalInternalReflectionBeyondTheCriticalAngle) {
     ro.camera = ortho({0, 0, -1}, {std::sin(a), 0, std::cos(a)}, 0.01);
     ro.bounces = 3;
     ro.shadeBack = true;
-    const Image img = render(s, grid, AccelKind::Grid, ro);
+    const Image img = renderWith(s, grid, AccelKind::Grid, ro);
     const float* p = img.at(1, 1);
     const bool transmitted = deg < std::asin(1 / 1.5) * 180 / M_PI;
     EXPECT_EQ(p[0] > 0, transmitted) << deg;
@@ -224,13 +203,13 @@ TEST(ShadeBackFaces, BlackWithoutShadeBackLitWithIt) {
   s.materials = {phong({1, 1, 1})};
   s.ambient = {0.5, 0.5, 0.5};
   addQuad(s, {-1, -1, 0}, {-1, 1, 0}, {1, 1, 0}, {1, -1, 0}, 0);  // normal -z: its back faces the camera at +z
-  const Grid grid = voxelize(s, {2, 2, 1});
+  const Grid grid = voxelizeWith(s, {2, 2, 1});
   RenderOptions ro;
   ro.width = ro.height = 5;
   ro.camera = ortho({0, 0, 5}, {0, 0, -1}, 1);
-  EXPECT_EQ(render(s, grid, AccelKind::Grid, ro).at(2, 2)[0], 0.0f);
+  EXPECT_EQ(renderWith(s, grid, AccelKind::Grid, ro).at(2, 2)[0], 0.0f);
   ro.shadeBack = true;
-  EXPECT_FLOAT_EQ(render(s, grid, AccelKind::Grid, ro).at(2, 2)[0], 1.5f);  // ambient 0.5 + headlight 1
+  EXPECT_FLOAT_EQ(renderWith(s, grid, AccelKind::Grid, ro).at(2, 2)[0], 1.5f);  // ambient 0.5 + headlight 1
 }
 
 // ---- grid == brute force ----
@@ -253,7 +232,7 @@ TEST(ShadeGridVsBruteForce, RandomReflectiveAndRefractiveScenes) {
     s.ambient = {0.1, 0.1, 0.1};
     for (OverlapMethod method : {OverlapMethod::Exact, OverlapMethod::Sat, OverlapMethod::BBox}) {
       const uint32_t n = 1 + seed % 9;
-      const Grid grid = voxelize(s, {n, n + 2, n + 1}, method);
+      const Grid grid = voxelizeWith(s, {n, n + 2, n + 1}, method);
       RenderOptions ro;
       ro.width = ro.height = kSanitized ? 16 : 32;
       ro.samples = seed % 3 == 0 ? 4 : 1;
@@ -263,8 +242,8 @@ TEST(ShadeGridVsBruteForce, RandomReflectiveAndRefractiveScenes) {
       ro.camera.direction = Vec3{0.5, 0.45, 0.5} - ro.camera.center + Vec3{0.01, 0, 0};
       ro.camera.fovDegrees = 70;
       RenderStats gs, ns;
-      const Image g = render(s, grid, AccelKind::Grid, ro, &gs);
-      const Image b = render(s, grid, AccelKind::None, ro, &ns);
+      const Image g = renderWith(s, grid, AccelKind::Grid, ro, &gs);
+      const Image b = renderWith(s, grid, AccelKind::None, ro, &ns);
       EXPECT_EQ(differingPixels(g, b), 0) << "seed " << seed << " " << methodName(method);
       EXPECT_EQ(gs.trace.rays, ns.trace.rays);                             // the same rays, of every depth
       EXPECT_GT(gs.trace.rays, 2ull * ro.width * ro.height * ro.samples);  // secondary and shadow rays were traced
@@ -316,10 +295,10 @@ TEST_P(CourseBounces, GridAndBruteForceImagesAreIdentical) {
   ro.shadeBack = c.shadeBack;
   ro.shadows = c.shadows;
   ro.camera = *scene.camera;
-  const Grid grid = voxelize(scene, c.dims);
+  const Grid grid = voxelizeWith(scene, c.dims);
   RenderStats gs, ns;
-  const Image g = render(scene, grid, AccelKind::Grid, ro, &gs);
-  const Image b = render(scene, grid, AccelKind::None, ro, &ns);
+  const Image g = renderWith(scene, grid, AccelKind::Grid, ro, &gs);
+  const Image b = renderWith(scene, grid, AccelKind::None, ro, &ns);
   EXPECT_EQ(differingPixels(g, b), 0);
   EXPECT_EQ(gs.trace.rays, ns.trace.rays);
   if (c.bounces > 0) {
@@ -339,14 +318,14 @@ INSTANTIATE_TEST_SUITE_P(Assignments6And7, CourseBounces, ::testing::ValuesIn(kC
 
 // A 24-bit TGA as the course's code writes it (seed-scenes/6837/README.md "TGA format": 18-byte header, type 2,
 // 24 bits, top-left origin), as RGB bytes, rows from the top.
-struct Rgb8 {
+struct TgaImage {
   uint32_t width = 0, height = 0;
   std::vector<uint8_t> rgb;
 };
-Rgb8 readCourseTga(const std::string& path) {
+TgaImage readCourseTga(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  Rgb8 out;
+  TgaImage out;
   if (bytes.size() < 18) return out;
   const auto byte = [&](size_t i) { return uint8_t(bytes[i]); };
   EXPECT_EQ(byte(2), 2);
@@ -355,7 +334,7 @@ Rgb8 readCourseTga(const std::string& path) {
   out.width = byte(12) | byte(13) << 8;
   out.height = byte(14) | byte(15) << 8;
   const size_t start = 18 + byte(0), n = size_t(out.width) * out.height;
-  if (bytes.size() < start + 3 * n) return Rgb8{};
+  if (bytes.size() < start + 3 * n) return TgaImage{};
   for (size_t p = 0; p < n; ++p)
     for (int c = 2; c >= 0; --c) out.rgb.push_back(byte(start + 3 * p + c));  // B, G, R
   return out;
@@ -363,7 +342,7 @@ Rgb8 readCourseTga(const std::string& path) {
 
 // Mean absolute difference per channel, 0..255, between `img` written to 8 bits (clamped and rounded, as
 // writeImage does) and `ref` averaged over blocks of `scale` x `scale` pixels down to img's size.
-double meanDifference(const Image& img, const Rgb8& ref, uint32_t scale) {
+double meanDifference(const Image& img, const TgaImage& ref, uint32_t scale) {
   EXPECT_EQ(img.width * scale, ref.width);
   EXPECT_EQ(img.height * scale, ref.height);
   if (img.width * scale != ref.width || img.height * scale != ref.height) return 255;
@@ -389,12 +368,12 @@ double meanDifference(const Image& img, const Rgb8& ref, uint32_t scale) {
 TEST(CourseCamera, WideLogoLineFramesLikeTheCourse) {
   const std::string dir = std::string(VOX_SEED_DIR) + "/6837/";
   const Scene scene = loadScene(dir + "scenes/scene6_18_6.837_logo.txt");
-  const Rgb8 student = readCourseTga(dir + "unofficial-renders/tsssni-mit-6.837/assignment6/output6_18a.tga");
+  const TgaImage student = readCourseTga(dir + "unofficial-renders/tsssni-mit-6.837/assignment6/output6_18a.tga");
   ASSERT_EQ(student.width, 400u);
   ASSERT_EQ(student.height, 200u);
   ASSERT_TRUE(scene.camera);
   ASSERT_EQ(scene.camera->span, CameraSpan::LongerSide);
-  const Grid grid = voxelize(scene, {80, 30, 3});
+  const Grid grid = voxelizeWith(scene, {80, 30, 3});
   const Accel accel = buildAccel(scene, grid, AccelKind::Grid);
   const uint32_t scale = kSanitized ? 4 : 1;  // the sanitizers' run compares a quarter-size image
   RenderOptions ro;

@@ -5,12 +5,34 @@
 
 #include <atomic>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <random>
 #include <string>
 
 #include "vox/core/scene.h"
 
 namespace vox::testing {
+
+// Whether the sanitizers are on (the CI's second run): the tests then run the same checks on smaller inputs.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kSanitized = true;
+#else
+constexpr bool kSanitized = false;
+#endif
+
+#ifdef VOX_SEED_DIR
+// A file of the bundled test data (data/), by its path inside it.
+inline std::string seed(const std::string& rel) { return std::string(VOX_SEED_DIR) + "/" + rel; }
+#endif
+
+// The whole content of a file, "" when it cannot be read.
+inline std::string readAll(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
 
 class ScratchDir {
  public:

@@ -22,16 +22,11 @@
 namespace vox {
 namespace {
 
+using testing::readAll;
+
+using testing::seed;
+
 using testing::ScratchDir;
-
-std::string seed(const std::string& rel) { return std::string(VOX_SEED_DIR) + "/" + rel; }
-
-std::string readAll(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 void writeAll(const std::string& path, const std::string& bytes) { std::ofstream(path, std::ios::binary) << bytes; }
 

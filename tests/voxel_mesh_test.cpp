@@ -19,17 +19,17 @@
 namespace vox {
 namespace {
 
-using Cell = std::array<int, 3>;
-using CellSet = std::set<Cell>;
+using IntCell = std::array<int, 3>;
+using IntCellSet = std::set<IntCell>;
 
 // A grid whose cells are `cells`; cell c holds 1 + (its rank % 3) primitives (triangles of the scene below).
 // The bounds give non-uniform but binary-exact cell sizes (0.5, 0.25, 2), so volumes and areas are exact sums.
-Grid makeGrid(const std::array<uint32_t, 3>& dims, const CellSet& cells, const CellSet& solid = {}) {
+Grid makeGrid(const std::array<uint32_t, 3>& dims, const IntCellSet& cells, const IntCellSet& solid = {}) {
   Grid g;
   g.dims = dims;
   g.bounds = {{-1, 2, 0.5}, {-1 + 0.5 * dims[0], 2 + 0.25 * dims[1], 0.5 + 2.0 * dims[2]}};
   std::vector<uint64_t> keys;
-  for (const Cell& c : cells) keys.push_back(cellKey(dims, c[0], c[1], c[2]));
+  for (const IntCell& c : cells) keys.push_back(cellKey(dims, c[0], c[1], c[2]));
   std::sort(keys.begin(), keys.end());
   g.cellKeys.assign(keys.begin(), keys.end());
   g.cellStart = {0};
@@ -38,7 +38,7 @@ Grid makeGrid(const std::array<uint32_t, 3>& dims, const CellSet& cells, const C
     g.cellStart.push_back(g.primIds.size());
   }
   std::vector<uint64_t> solidKeys;
-  for (const Cell& c : solid) solidKeys.push_back(cellKey(dims, c[0], c[1], c[2]));
+  for (const IntCell& c : solid) solidKeys.push_back(cellKey(dims, c[0], c[1], c[2]));
   std::sort(solidKeys.begin(), solidKeys.end());
   for (uint64_t key : solidKeys) appendSolidKey(g.solidRuns, key);
   return g;
@@ -146,9 +146,9 @@ Topology analyse(const VoxelMesh& m, const Vec3& ref) {
 // ----- independent topology of a voxel set -----
 
 // Cubical Euler characteristic of the union of closed cubes: chi = V - E + F - C over the cells of the complex.
-long cubicalEuler(const CellSet& cells) {
+long cubicalEuler(const IntCellSet& cells) {
   std::set<std::array<int, 4>> verts, edges, faces;  // (x2, y2, z2) doubled coordinates of centres
-  for (const Cell& c : cells)
+  for (const IntCell& c : cells)
     for (int dz = 0; dz <= 2; ++dz)
       for (int dy = 0; dy <= 2; ++dy)
         for (int dx = 0; dx <= 2; ++dx) {
@@ -162,19 +162,19 @@ long cubicalEuler(const CellSet& cells) {
 }
 
 // Components of a set of cells under face adjacency.
-size_t faceComponents(const CellSet& cells) {
-  std::set<Cell> left = cells;
+size_t faceComponents(const IntCellSet& cells) {
+  std::set<IntCell> left = cells;
   size_t n = 0;
   while (!left.empty()) {
     ++n;
-    std::vector<Cell> stack{*left.begin()};
+    std::vector<IntCell> stack{*left.begin()};
     left.erase(left.begin());
     while (!stack.empty()) {
-      const Cell c = stack.back();
+      const IntCell c = stack.back();
       stack.pop_back();
       for (int a = 0; a < 3; ++a)
         for (int s : {-1, 1}) {
-          Cell d = c;
+          IntCell d = c;
           d[a] += s;
           auto it = left.find(d);
           if (it != left.end()) {
@@ -188,8 +188,8 @@ size_t faceComponents(const CellSet& cells) {
 }
 
 // Empty components enclosed by the voxels (cavities), in the box grown by one cell so the outside is one component.
-size_t cavities(const CellSet& cells, const std::array<uint32_t, 3>& dims) {
-  CellSet empty;
+size_t cavities(const IntCellSet& cells, const std::array<uint32_t, 3>& dims) {
+  IntCellSet empty;
   for (int z = -1; z <= int(dims[2]); ++z)
     for (int y = -1; y <= int(dims[1]); ++y)
       for (int x = -1; x <= int(dims[0]); ++x)
@@ -200,7 +200,7 @@ size_t cavities(const CellSet& cells, const std::array<uint32_t, 3>& dims) {
 // Well-composed sets (no two cells meeting only along an edge or at a corner, neither voxels nor empty cells):
 // add voxels until no critical configuration is left. For them the closed union is a 3-manifold with boundary and
 // the voxel surface's Euler characteristic is twice the union's.
-CellSet makeWellComposed(CellSet cells, const std::array<uint32_t, 3>& dims) {
+IntCellSet makeWellComposed(IntCellSet cells, const std::array<uint32_t, 3>& dims) {
   auto in = [&](int x, int y, int z) { return cells.count({x, y, z}) > 0; };
   for (bool changed = true; changed;) {
     changed = false;
@@ -211,7 +211,7 @@ CellSet makeWellComposed(CellSet cells, const std::array<uint32_t, 3>& dims) {
           int occ = 0;
           for (int o = 0; o < 8; ++o) occ |= int(in(x + (o & 1), y + ((o >> 1) & 1), z + (o >> 2))) << o;
           auto fillOne = [&](int o) {
-            const Cell c{x + (o & 1), y + ((o >> 1) & 1), z + (o >> 2)};
+            const IntCell c{x + (o & 1), y + ((o >> 1) & 1), z + (o >> 2)};
             if (c[0] < 0 || c[1] < 0 || c[2] < 0 || c[0] >= int(dims[0]) || c[1] >= int(dims[1]) ||
                 c[2] >= int(dims[2]))
               return false;
@@ -243,9 +243,9 @@ CellSet makeWellComposed(CellSet cells, const std::array<uint32_t, 3>& dims) {
   return cells;
 }
 
-CellSet randomCells(std::mt19937& rng, const std::array<uint32_t, 3>& dims, double density) {
+IntCellSet randomCells(std::mt19937& rng, const std::array<uint32_t, 3>& dims, double density) {
   std::bernoulli_distribution take(density);
-  CellSet cells;
+  IntCellSet cells;
   for (uint32_t z = 0; z < dims[2]; ++z)
     for (uint32_t y = 0; y < dims[1]; ++y)
       for (uint32_t x = 0; x < dims[0]; ++x)
@@ -308,8 +308,8 @@ TEST(ColorMap, EndsAndMonotoneLuminance) {
 TEST(VoxelMesh, AllModeHasACubePerVoxel) {
   std::mt19937 rng(1);
   const std::array<uint32_t, 3> dims{5, 4, 3};
-  const CellSet cells = randomCells(rng, dims, 0.4);
-  const CellSet solid{{4, 3, 2}};
+  const IntCellSet cells = randomCells(rng, dims, 0.4);
+  const IntCellSet solid{{4, 3, 2}};
   const Grid g = makeGrid(dims, cells, solid);
   const size_t n = cells.size() + (cells.count({4, 3, 2}) ? 0 : 1);
   const VoxelMesh m = buildVoxelMesh(g, makeScene(), FaceMode::All, ColorMode::Count);
@@ -328,7 +328,7 @@ TEST(VoxelMesh, AllModeHasACubePerVoxel) {
 struct KnownShape {
   const char* name;
   std::array<uint32_t, 3> dims;
-  CellSet cells;
+  IntCellSet cells;
   long euler;       // of the voxel surface, from the shape's construction
   size_t vertices;  // of the exposed mesh, 0 when not checked
 };
@@ -339,34 +339,34 @@ std::vector<KnownShape> knownShapes() {
   s.push_back({"edge pair", {2, 2, 1}, {{0, 0, 0}, {1, 1, 0}}, 4, 16});  // two spheres, edge split at both ends
   s.push_back({"corner pair", {2, 2, 2}, {{0, 0, 0}, {1, 1, 1}}, 4, 16});
   s.push_back({"checkerboard 2x2x2", {2, 2, 2}, {{0, 0, 0}, {1, 1, 0}, {1, 0, 1}, {0, 1, 1}}, 8, 32});
-  CellSet ring;
+  IntCellSet ring;
   for (int x = 0; x < 3; ++x)
     for (int y = 0; y < 3; ++y)
       if (x != 1 || y != 1) ring.insert({x, y, 0});
   s.push_back({"torus ring", {3, 3, 1}, ring, 0, 32});
-  CellSet twoHoles;
+  IntCellSet twoHoles;
   for (int x = 0; x < 5; ++x)
     for (int y = 0; y < 3; ++y)
       if (y != 1 || (x != 1 && x != 3)) twoHoles.insert({x, y, 0});
   s.push_back({"double torus", {5, 3, 1}, twoHoles, -2, 0});
-  CellSet hollow;
+  IntCellSet hollow;
   for (int x = 0; x < 3; ++x)
     for (int y = 0; y < 3; ++y)
       for (int z = 0; z < 3; ++z)
         if (x != 1 || y != 1 || z != 1) hollow.insert({x, y, z});
   s.push_back({"cavity", {3, 3, 3}, hollow, 4, 64});
   // 2x2x2 block without two opposite corners: a ball, but the centre point has two sheets (one per missing cell).
-  CellSet block;
+  IntCellSet block;
   for (int o = 1; o < 7; ++o) block.insert({o & 1, (o >> 1) & 1, o >> 2});
   s.push_back({"block minus opposite corners", {2, 2, 2}, block, 2, 0});
   // Full layer, diagonal pair, full layer: keeping the pair apart would collapse a tunnel onto the middle edge
   // (four faces on one edge); joining it leaves two dents in a ball.
-  CellSet sandwich{{0, 0, 1}, {1, 1, 1}};
+  IntCellSet sandwich{{0, 0, 1}, {1, 1, 1}};
   for (int z : {0, 2})
     for (int o = 0; o < 4; ++o) sandwich.insert({o & 1, o >> 1, z});
   s.push_back({"sandwich", {2, 2, 3}, sandwich, 2, 0});
   // Edge-touching rings linked like a chain: two tori meeting along an edge stay two tori.
-  CellSet chain = ring;
+  IntCellSet chain = ring;
   for (int x = 0; x < 3; ++x)
     for (int z = 0; z < 3; ++z)
       if (x != 1 || z != 1) chain.insert({x + 3, 1, z + 1});
@@ -399,7 +399,7 @@ TEST(VoxelMesh, KnownShapesExposedAndMerged) {
 
 TEST(VoxelMesh, ExposedFacesOfACube) {
   // A 2x3x4 box: exposed squares are its surface cells, merged faces are its six sides.
-  CellSet box;
+  IntCellSet box;
   for (int x = 0; x < 2; ++x)
     for (int y = 0; y < 3; ++y)
       for (int z = 0; z < 4; ++z) box.insert({x, y, z});
@@ -423,7 +423,7 @@ TEST(VoxelMesh, RandomSetsAreClosedManifoldsOfTheRightVolume) {
     const std::array<uint32_t, 3> dims{uint32_t(2 + trial % 7), uint32_t(2 + (trial / 2) % 6),
                                        uint32_t(1 + (trial / 3) % 6)};
     const double density = 0.15 + 0.7 * (trial % 10) / 10.0;
-    const CellSet cells = randomCells(rng, dims, density);
+    const IntCellSet cells = randomCells(rng, dims, density);
     const Grid g = makeGrid(dims, cells);
     const std::string what = "trial " + std::to_string(trial);
     const VoxelMesh e = buildVoxelMesh(g, makeScene(), FaceMode::Exposed, ColorMode::Count);
@@ -446,7 +446,7 @@ TEST(VoxelMesh, LargeDenseRandomSetsStayManifold) {
   std::mt19937 rng(11);
   for (double density : {0.3, 0.5, 0.7}) {
     const std::array<uint32_t, 3> dims{19, 17, 18};
-    const CellSet cells = randomCells(rng, dims, density);
+    const IntCellSet cells = randomCells(rng, dims, density);
     const Grid g = makeGrid(dims, cells);
     expectSound(buildVoxelMesh(g, makeScene(), FaceMode::Exposed, ColorMode::None), g, cells.size(), "exposed");
     expectSound(buildVoxelMesh(g, makeScene(), FaceMode::Merged, ColorMode::None), g, cells.size(), "merged");
@@ -457,7 +457,7 @@ TEST(VoxelMesh, EulerCharacteristicMatchesWellComposedSets) {
   std::mt19937 rng(3);
   for (int trial = 0; trial < 40; ++trial) {
     const std::array<uint32_t, 3> dims{uint32_t(3 + trial % 5), uint32_t(3 + (trial / 5) % 4), uint32_t(2 + trial % 4)};
-    const CellSet cells = makeWellComposed(randomCells(rng, dims, 0.35 + 0.05 * (trial % 6)), dims);
+    const IntCellSet cells = makeWellComposed(randomCells(rng, dims, 0.35 + 0.05 * (trial % 6)), dims);
     const Grid g = makeGrid(dims, cells);
     const std::string what = "trial " + std::to_string(trial);
     const long chi = 2 * cubicalEuler(cells);
@@ -478,7 +478,7 @@ TEST(VoxelMesh, MergedHasNoTJunctions) {
   // edge, the other sheet's vertices may lie on a face's edge without belonging to the same sheet.
   std::mt19937 rng(5);
   const std::array<uint32_t, 3> dims{11, 9, 5};
-  const CellSet cells = makeWellComposed(randomCells(rng, dims, 0.45), dims);
+  const IntCellSet cells = makeWellComposed(randomCells(rng, dims, 0.45), dims);
   const Grid g = makeGrid(dims, cells);
   const VoxelMesh m = buildVoxelMesh(g, makeScene(), FaceMode::Merged, ColorMode::Count);
   std::set<std::array<double, 3>> points;
@@ -505,7 +505,7 @@ TEST(VoxelMesh, MergedHasNoTJunctions) {
 TEST(VoxelMesh, TriangulationKeepsSurfaceWithoutDegenerateTriangles) {
   std::mt19937 rng(9);
   const std::array<uint32_t, 3> dims{8, 7, 6};
-  const CellSet cells = randomCells(rng, dims, 0.5);
+  const IntCellSet cells = randomCells(rng, dims, 0.5);
   const Grid g = makeGrid(dims, cells);
   const VoxelMesh m = buildVoxelMesh(g, makeScene(), FaceMode::Merged, ColorMode::Count);
   const VoxelMesh t = triangulateVoxelMesh(m);
@@ -526,8 +526,8 @@ TEST(VoxelMesh, TriangulationKeepsSurfaceWithoutDegenerateTriangles) {
 }
 
 TEST(VoxelMesh, ColoursFollowCountsMaterialsAndSolidCells) {
-  const CellSet cells{{0, 0, 0}, {2, 0, 0}, {4, 0, 0}};
-  const CellSet solid{{0, 2, 0}};
+  const IntCellSet cells{{0, 0, 0}, {2, 0, 0}, {4, 0, 0}};
+  const IntCellSet solid{{0, 2, 0}};
   const Grid g = makeGrid({5, 3, 1}, cells, solid);  // cells hold 1, 2, 3 primitives (materials 0; 0,1; 0,1,2)
   const VoxelMesh count = buildVoxelMesh(g, makeScene(), FaceMode::All, ColorMode::Count);
   ASSERT_EQ(count.faceCount(), 48u);

@@ -10,7 +10,7 @@
 namespace vox {
 namespace {
 
-std::vector<Triangle> cube(double a, double b, bool inward) {
+std::vector<Triangle> boxTriangles(double a, double b, bool inward) {
   Vec3 p[8];
   for (int c = 0; c < 8; ++c) p[c] = {(c & 1) ? b : a, (c & 2) ? b : a, (c & 4) ? b : a};
   const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
@@ -25,7 +25,7 @@ std::vector<Triangle> cube(double a, double b, bool inward) {
 }
 
 TEST(WindingNumber, ClosedCubeInsideOutsideAndOrientation) {
-  const auto out = cube(0, 1, false), in = cube(0, 1, true);
+  const auto out = boxTriangles(0, 1, false), in = boxTriangles(0, 1, true);
   EXPECT_NEAR(windingNumberExact(out, {0.5, 0.5, 0.5}), 1, 1e-12);
   EXPECT_NEAR(windingNumberExact(out, {0.01, 0.99, 0.3}), 1, 1e-9);
   EXPECT_NEAR(windingNumberExact(out, {1.5, 0.5, 0.5}), 0, 1e-12);

@@ -32,7 +32,7 @@ double grad(int hash, double x, double y, double z) {
   return ((h & 1) == 0 ? u : -u) + ((h & 2) == 0 ? v : -v);
 }
 // The lattice cell index modulo 256; fmod keeps huge coordinates (beyond int) defined.
-int cellIndex(double floored) {
+int latticeIndex(double floored) {
   const double m = std::fmod(floored, 256.0);
   return (int(m) + 256) & 255;
 }
@@ -42,7 +42,7 @@ int cellIndex(double floored) {
 double perlinNoise(double x, double y, double z) {
   if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) return 0;
   const double fx = std::floor(x), fy = std::floor(y), fz = std::floor(z);
-  const int X = cellIndex(fx), Y = cellIndex(fy), Z = cellIndex(fz);
+  const int X = latticeIndex(fx), Y = latticeIndex(fy), Z = latticeIndex(fz);
   x -= fx, y -= fy, z -= fz;
   const double u = fade(x), v = fade(y), w = fade(z);
   const int A = perm(X) + Y, AA = perm(A) + Z, AB = perm(A + 1) + Z;

@@ -18,6 +18,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "convert.h"
 #include "vox/core/error.h"
 #include "vox/core/grid.h"
 #include "vox/core/scene.h"
@@ -34,11 +35,12 @@ namespace py = pybind11;
 // (intersect, occluded, render) and kept.
 class PyGrid {
  public:
+  // `source`: the file system bytes of the path it came from, or "<arrays>".
   PyGrid(vox::GridFile file, std::string source);
   const vox::GridFile& file() const { return *file_; }
   const vox::Grid& grid() const { return file_->grid; }
   const vox::Scene& scene() const { return file_->scene; }
-  // Where it came from: a path, or "<arrays>"; named in messages.
+  // Where it came from: a path's bytes, or "<arrays>"; named in messages (decoded with replacement).
   const std::string& source() const { return source_; }
   // The Accel of the grid walk, built once (thread-safe); call with the GIL released, it can take a while.
   const vox::Accel& accel();
@@ -89,9 +91,6 @@ class Interrupt {
 // when tqdm is not installed), or a callable taking the fraction done. TypeError for anything else.
 py::object progressCallable(const py::object& progress, const char* label);
 
-// The worker threads of a call: nullopt for all cores, else 1..4096 (UsageError otherwise).
-std::optional<int> threadsArg(const py::object& threads);
-
 // Runs `work` with the GIL released, on `threads` worker threads (a TBB arena of that many; the caller's when
 // nullopt), then raises what `interrupt` caught (KeyboardInterrupt) in place of the library's error or result.
 template <class Work>
@@ -130,6 +129,9 @@ auto runLong(Interrupt& interrupt, std::optional<int> threads, Work&& work) -> d
 
 // ---- Arguments (arrays.cpp) ----
 
+// np.asarray(obj): TypeError naming `name` for a str, bytes or what numpy cannot take; InputError for a ragged
+// sequence (rows of different lengths), whose shape is the problem, as for an array of the wrong shape.
+py::array asArray(const py::handle& obj, const char* name);
 // An (N, 3) array of coordinates as doubles: float16/32/64 widened exactly, integers up to 2^53 exactly. TypeError
 // for another dtype; InputError naming `name` for another shape, an empty array (unless allowEmpty) or a value that
 // is not finite.
@@ -139,14 +141,6 @@ std::vector<vox::Vec3> vec3Array(const py::handle& obj, const char* name, bool a
 std::vector<std::array<uint32_t, 3>> faceArray(const py::handle& obj, const char* name, size_t vertexCount);
 // A triangle scene from vertex and face arrays (triangle i is face i), with the importers' default white material.
 vox::Scene sceneFromArrays(const py::handle& vertices, const py::handle& faces);
-// Three numbers (a sequence or array of 3) as doubles / as cell counts; UsageError naming `name` otherwise.
-vox::Vec3 vec3Arg(const py::handle& obj, const char* name);
-std::array<uint32_t, 3> dims3Arg(const py::handle& obj, const char* name);
-// ((x0, y0, z0), (x1, y1, z1)) or a (2, 3) array as a Box; UsageError otherwise.
-vox::Box boxArg(const py::handle& obj, const char* name);
-// A str or os.PathLike as a file system path, or nullopt for anything else.
-std::optional<std::string> pathArg(const py::handle& obj);
-
 // A numpy array of element type T over the memory of `data` (no copy), which it takes over and frees when the array
 // is freed: T may differ from U where the layout allows (a Vec3 is three doubles; uint32 ids below 2^31 read as
 // int32). Read-only when `readOnly`.
@@ -166,17 +160,6 @@ py::array_t<T> readOnlyView(const T* data, std::vector<py::ssize_t> shape, py::h
   py::array_t<T> out(shape, data, base);
   py::detail::array_proxy(out.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
   return out;
-}
-
-// An option's value parsed by the library's parser (parseFaceMode, parseColorMode, ...), whose InputError becomes a
-// UsageError naming the keyword argument: a bad option is the caller's usage, not a bad file.
-template <class Parse>
-auto optionArg(const char* name, const std::string& value, Parse&& parse) {
-  try {
-    return parse(value);
-  } catch (const vox::InputError& e) {
-    throw vox::UsageError(std::string(name) + ": " + e.what());
-  }
 }
 
 // ---- Registration, one function per file ----

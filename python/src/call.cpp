@@ -60,24 +60,13 @@ void Interrupt::finish(bool completed) {
 
 py::object progressCallable(const py::object& progress, const char* label) {
   if (progress.is_none()) return py::none();
-  if (py::isinstance<py::bool_>(progress)) {
-    if (!progress.cast<bool>()) return py::none();
+  if (isBool(progress)) {
+    if (!boolArg(progress, "progress")) return py::none();
     return py::module_::import("libvox._progress").attr("bar")(label);
   }
   if (!PyCallable_Check(progress.ptr()))
-    throw py::type_error("progress must be None, a bool or a callable taking the fraction done, not " +
-                         std::string(py::str(py::type::of(progress).attr("__name__"))));
+    failType("progress must be None, a bool or a callable taking the fraction done, not ", typeName(progress));
   return progress;
-}
-
-std::optional<int> threadsArg(const py::object& threads) {
-  if (threads.is_none()) return std::nullopt;
-  if (py::isinstance<py::bool_>(threads) || !py::isinstance<py::int_>(threads))
-    throw py::type_error("threads must be None or an int, not " +
-                         std::string(py::str(py::type::of(threads).attr("__name__"))));
-  const long long n = threads.cast<long long>();
-  if (n < 1 || n > 4096) vox::fail<vox::UsageError>("threads must be 1..4096 (None: all cores), got ", n);
-  return int(n);
 }
 
 void inArena(std::optional<int> threads, const std::function<void()>& body) {

@@ -1,6 +1,7 @@
 // The library's exceptions as Python exceptions (DESIGN.md "Python"): InputError(ValueError),
 // UsageError(ValueError), LimitError(MemoryError), OutputError -> OSError; the message is the library's, naming the
-// file and the place.
+// file and the place. Every message, the library's and the binding's, is decoded with replacement: a scene's line or a
+// path that is not UTF-8 must not turn the error into a UnicodeDecodeError (or an empty one).
 #include "binding.h"
 #include "vox/core/error.h"
 
@@ -21,6 +22,9 @@ PyObject* newException(py::module_& m, const char* name, PyObject* base, const c
   return type;
 }
 
+// Sets the Python error `type` with the message bytes `what`, decoded with replacement.
+void setError(PyObject* type, const char* what) { PyErr_SetObject(type, messageText(what).ptr()); }
+
 }  // namespace
 
 void bindErrors(py::module_& m) {
@@ -39,17 +43,24 @@ void bindErrors(py::module_& m) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const vox::InputError& e) {
-      PyErr_SetString(inputError, e.what());
+      setError(inputError, e.what());
     } catch (const vox::UsageError& e) {
-      PyErr_SetString(usageError, e.what());
+      setError(usageError, e.what());
     } catch (const vox::LimitError& e) {
-      PyErr_SetString(limitError, e.what());
+      setError(limitError, e.what());
     } catch (const vox::OutputError& e) {
-      PyErr_SetString(PyExc_OSError, e.what());
+      setError(PyExc_OSError, e.what());
     } catch (const vox::Error& e) {
-      PyErr_SetString(PyExc_RuntimeError, e.what());
+      setError(PyExc_RuntimeError, e.what());
     } catch (const std::bad_alloc&) {
       PyErr_SetString(limitError, "out of memory");
+    } catch (const py::cast_error& e) {
+      // pybind11's "Unable to cast Python instance": a value of the wrong type, whatever pybind11 calls it.
+      setError(PyExc_TypeError, e.what());
+    } catch (const py::type_error& e) {
+      setError(PyExc_TypeError, e.what());
+    } catch (const py::value_error& e) {
+      setError(PyExc_ValueError, e.what());
     }
   });
 }

@@ -55,7 +55,8 @@ py::array_t<int32_t> solidIndices(PyGrid& self) {
   return out;
 }
 
-py::array_t<bool> dense(PyGrid& self, bool solid) {
+py::array_t<bool> dense(PyGrid& self, const py::object& solidArg) {
+  const bool solid = boolArg(solidArg, "solid");
   const Grid& g = self.grid();
   checkArray(self, double(g.cellCount()), "dense()");
   const auto [nx, ny, nz] = g.dims;
@@ -142,13 +143,18 @@ std::string repr(const PyGrid& self) {
 // Pickling (Grid.__getstate__): the state is (bytes of the grid file, source), the bytes being exactly what
 // grid.save("x.vgrid") writes (vox::encodeGridFile: the scene, the cells, the solid runs and every optional section),
 // so a grid sent to another process or machine is the same grid cell for cell and primitive for primitive.
+// Grid.source as Python shows it: a path as os.fsdecode gives it (a name that is not UTF-8 round-trips).
+py::str sourceText(const PyGrid& self) {
+  return self.source() == "<arrays>" ? py::str(self.source()) : pathText(self.source());
+}
+
 py::object getState(const PyGrid& self) {
   std::string bytes;
   {
     py::gil_scoped_release release;
     bytes = vox::encodeGridFile(self.scene(), self.grid());
   }
-  return py::make_tuple(py::bytes(bytes), self.source());
+  return py::make_tuple(py::bytes(bytes), sourceText(self));
 }
 
 // Grid.__setstate__: decodes the bytes with every check libvox.load makes (counts, offsets, ids, checksum), so a
@@ -159,9 +165,10 @@ std::shared_ptr<PyGrid> setState(const py::object& state) {
     throw py::type_error(
         "libvox.Grid.__setstate__: the state must be a tuple (bytes of a grid file, source str), "
         "got " +
-        std::string(py::str(py::type::of(state).attr("__name__"))));
+        typeName(state));
   std::string bytes = state[py::int_(0)].cast<std::string>();
-  const std::string source = state[py::int_(1)].cast<std::string>();
+  const py::object sourceObj = state[py::int_(1)];
+  const std::string source = sourceObj.equal(py::str("<arrays>")) ? "<arrays>" : pathArg(sourceObj, "source");
   vox::GridFile file;
   {
     py::gil_scoped_release release;
@@ -261,7 +268,8 @@ solid cells too when `solid`. LimitError when nx*ny*nz bytes exceed the memory b
 For each point of `points` ((P, 3) float), whether a closed cell holding it is occupied or solid: (P,) bool. A point
 on a boundary between cells counts for both; points outside the bounds are False.
 )doc")
-      .def_property_readonly("source", &PyGrid::source, "Where the grid came from: a file path, or '<arrays>'.")
+      .def_property_readonly("source", &sourceText,
+                             "Where the grid came from: a file path (as os.fsdecode gives it), or '<arrays>'.")
       .def("__repr__", &repr)
       .def(py::pickle(&getState, &setState))
       // What pickle calls (every protocol, and copy.copy / copy.deepcopy): made as protocol 2 makes it, so that
@@ -275,11 +283,10 @@ on a boundary between cells counts for both; points outside the bounds are False
   m.def(
       "load",
       [](const py::object& path) {
-        const auto p = pathArg(path);
-        if (!p) throw py::type_error("path must be a str or os.PathLike");
+        const std::string p = pathArg(path, "path");
         Interrupt interrupt;
-        vox::GridFile file = runLong(interrupt, std::nullopt, [&] { return vox::readGridOrSet(*p); });
-        return std::make_shared<PyGrid>(std::move(file), *p);
+        vox::GridFile file = runLong(interrupt, std::nullopt, [&] { return vox::readGridOrSet(p); });
+        return std::make_shared<PyGrid>(std::move(file), p);
       },
       py::arg("path"), R"doc(
 Reads a grid file (.vgrid, vox-voxelize's output) or a grid set (vox-voxelize --bricks) with its scene. Every count,

@@ -18,9 +18,9 @@ py::array_t<uint8_t> rgba(const std::vector<vox::Rgb8>& colors) {
   return out;
 }
 
-py::tuple mesh(PyGrid& self, const std::string& facesName, const std::string& colorName, const py::object& threads) {
-  const vox::FaceMode faces = optionArg("faces", facesName, vox::parseFaceMode);
-  const vox::ColorMode color = optionArg("color", colorName, vox::parseColorMode);
+py::tuple mesh(PyGrid& self, const py::object& facesName, const py::object& colorName, const py::object& threads) {
+  const vox::FaceMode faces = enumArg(facesName, "faces", vox::parseFaceMode);
+  const vox::ColorMode color = enumArg(colorName, "color", vox::parseColorMode);
   Interrupt interrupt;
   vox::VoxelMesh m = runLong(interrupt, threadsArg(threads), [&] {
     return vox::triangulateVoxelMesh(vox::buildVoxelMesh(self.grid(), self.scene(), faces, color));
@@ -33,8 +33,8 @@ py::tuple mesh(PyGrid& self, const std::string& facesName, const std::string& co
                         adoptVector<int32_t>(std::move(m.faceVertices), {nf, 3}), colors);
 }
 
-py::array_t<uint8_t> colors(PyGrid& self, const std::string& modeName) {
-  const vox::ColorMode mode = optionArg("mode", modeName, vox::parseColorMode);
+py::array_t<uint8_t> colors(PyGrid& self, const py::object& modeName) {
+  const vox::ColorMode mode = enumArg(modeName, "mode", vox::parseColorMode);
   if (mode == vox::ColorMode::None) vox::fail<vox::UsageError>("mode: expected 'count' or 'material'");
   Interrupt interrupt;
   const auto c =

@@ -32,13 +32,19 @@ RayBatch rayBatch(const py::handle& origins, const py::handle& directions, const
   if (b.origins.size() != b.directions.size())
     vox::fail<vox::InputError>("origins and directions: ", b.origins.size(), " and ", b.directions.size(),
                                " rays; expected the same number");
-  const py::array t = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(tmax);
-  if (!t) throw py::type_error("tmax must be a number or an array of numbers");
-  if (t.ndim() == 0 || (t.ndim() == 1 && t.shape(0) == 1 && b.size() != 1)) {
-    b.tmax = {*static_cast<const double*>(t.data())};
-  } else if (t.ndim() == 1 && size_t(t.shape(0)) == b.size()) {
-    const double* p = static_cast<const double*>(t.data());
-    b.tmax.assign(p, p + b.size());
+  if (!isSequence(tmax)) {  // one number for every ray (infinity allowed: no limit)
+    b.tmax = {floatArg(tmax, "tmax", true)};
+    return b;
+  }
+  const py::array t = asArray(tmax, "tmax");
+  const char kind = t.dtype().kind();
+  if (!(kind == 'f' || kind == 'i' || kind == 'u') || t.dtype().itemsize() > 8)
+    failType("tmax must be a number or an array of numbers, not an array of ", std::string(py::str(t.dtype())));
+  const auto d = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(t);
+  if (d.ndim() == 1 && d.shape(0) == 1 && b.size() != 1) {
+    b.tmax = {d.data()[0]};
+  } else if (d.ndim() == 1 && size_t(d.shape(0)) == b.size()) {
+    b.tmax.assign(d.data(), d.data() + b.size());
   } else {
     vox::fail<vox::InputError>("tmax: expected a number or ", b.size(), " numbers");
   }
@@ -75,8 +81,8 @@ const vox::Accel& accelFor(PyGrid& self, vox::AccelKind kind, std::unique_ptr<vo
 }
 
 py::tuple intersect(PyGrid& self, const py::handle& origins, const py::handle& directions, const py::handle& tmax,
-                    const py::object& threads, const std::string& accelName) {
-  const vox::AccelKind kind = vox::parseAccel(accelName);
+                    const py::object& threads, const py::object& accelName) {
+  const vox::AccelKind kind = enumArg(accelName, "accel", vox::parseAccel);
   const RayBatch rays = rayBatch(origins, directions, tmax);
   const auto nThreads = threadsArg(threads);
   const py::ssize_t n = py::ssize_t(rays.size());
@@ -104,8 +110,8 @@ py::tuple intersect(PyGrid& self, const py::handle& origins, const py::handle& d
 }
 
 py::array_t<bool> occludedRays(PyGrid& self, const py::handle& origins, const py::handle& directions,
-                               const py::handle& tmax, const py::object& threads, const std::string& accelName) {
-  const vox::AccelKind kind = vox::parseAccel(accelName);
+                               const py::handle& tmax, const py::object& threads, const py::object& accelName) {
+  const vox::AccelKind kind = enumArg(accelName, "accel", vox::parseAccel);
   const RayBatch rays = rayBatch(origins, directions, tmax);
   const auto nThreads = threadsArg(threads);
   py::array_t<bool> out(py::ssize_t(rays.size()));

@@ -1,5 +1,7 @@
 // libvox.render and libvox.save_image: vox-trace's image as a numpy array, and its image writer.
+#include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include "binding.h"
 #include "vox/core/error.h"
@@ -17,18 +19,18 @@ constexpr uint64_t kMaxPixels = uint64_t(1) << 28;
 constexpr uint32_t kMaxSamples = 4096;
 constexpr uint32_t kMaxBounces = 10;
 
-template <class T>
-T uintArg(const py::object& obj, const char* name, T lo, T hi) {
-  if (py::isinstance<py::bool_>(obj) || !py::isinstance<py::int_>(obj))
-    throw py::type_error(std::string(name) + " must be an int, not " +
-                         std::string(py::str(py::type::of(obj).attr("__name__"))));
-  const long long v = obj.cast<long long>();
-  if (v < (long long)lo || v > (long long)hi) vox::fail<vox::UsageError>(name, " must be ", lo, "..", hi, ", got ", v);
-  return T(v);
+// A direction of any finite size scaled to one a length can be taken of: normalize() squares the components, so
+// 1e-300 underflows to a zero length and 1e300 overflows to infinity. Directions of ordinary size are kept as they
+// are (the camera is then vox-trace's, bit for bit).
+vox::Vec3 measurable(vox::Vec3 d) {
+  const double len = vox::length(d);
+  if (len > 0 && std::isfinite(len)) return d;
+  const double largest = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
+  return largest > 0 ? d / largest : d;
 }
 
 // The scene's camera (or one framing the grid) with vox-trace's overrides --eye/--look-at, --up, --fov applied, in
-// the same way (tools/trace/main.cpp, resolveCamera).
+// the same way (tools/trace/main.cpp, resolveCamera); UsageError naming the argument for a camera they cannot make.
 vox::Camera resolveCamera(const PyGrid& g, const py::object& eye, const py::object& lookAt, const py::object& up,
                           const py::object& fov) {
   using namespace vox;
@@ -41,53 +43,74 @@ vox::Camera resolveCamera(const PyGrid& g, const py::object& eye, const py::obje
     cam.kind = CameraKind::Perspective;
     cam.center = e;
     cam.direction = l - e;
+    // Halved, the difference of two finite doubles cannot overflow.
+    if (!isFinite(cam.direction)) cam.direction = l * 0.5 - e * 0.5;
+    if (cam.direction.x == 0 && cam.direction.y == 0 && cam.direction.z == 0)
+      fail<UsageError>("eye and look_at must differ (both are ", e.x, ", ", e.y, ", ", e.z, ")");
+    cam.direction = measurable(cam.direction);
     cam.up = scene.up;
     cam.fovDegrees = scene.kind == CameraKind::Perspective ? scene.fovDegrees : 45;
     // The scene's angle keeps the side it spans, so that moving the eye keeps the framing's width.
     if (scene.kind == CameraKind::Perspective) cam.span = scene.span;
-    if (!(length(cam.direction) > 0)) fail<UsageError>("eye and look_at must differ");
   }
-  if (!up.is_none()) cam.up = vec3Arg(up, "up");
+  if (!up.is_none()) {
+    cam.up = vec3Arg(up, "up");
+    if (cam.up.x == 0 && cam.up.y == 0 && cam.up.z == 0) fail<UsageError>("up must not be zero");
+    cam.up = measurable(cam.up);
+    if (!(length(cross(normalize(measurable(cam.direction)), cam.up)) > 0))
+      fail<UsageError>("up is parallel to the view direction", eye.is_none() ? " (the scene camera's)" : " (eye to look_at)");
+  }
   if (!fov.is_none()) {
-    const double f = fov.cast<double>();
+    const double f = floatArg(fov, "fov");
     if (!(f > 0 && f < 180)) fail<UsageError>("fov must be between 0 and 180 degrees, got ", f);
     cam.kind = CameraKind::Perspective;
     cam.fovDegrees = f;
     cam.span = CameraSpan::Height;  // fov is vertical, whatever the scene's camera spans
   }
-  validateCamera(cam, "camera");
+  // What is left to go wrong (the scene's up parallel to the new direction) is still the caller's choice of options.
+  try {
+    validateCamera(cam, "camera of eye, look_at, up, fov");
+  } catch (const InputError& e) {
+    throw UsageError(e.what());
+  }
   return cam;
 }
 
-py::array_t<float> render(PyGrid& self, const py::object& size, const std::string& mode, const py::object& samples,
-                          const py::object& bounces, double weight, bool shadeBack, bool shadows,
-                          const py::object& filter, const py::object& eye, const py::object& lookAt,
-                          const py::object& up, const py::object& fov, const std::string& accelName,
-                          const py::object& threads, const py::object& progress) {
+// vox-trace's options from render's arguments (all but the camera), each checked and named.
+vox::RenderOptions renderOptions(const py::object& size, const py::object& mode, const py::object& samples,
+                                 const py::object& bounces, const py::object& weight, const py::object& shadeBack,
+                                 const py::object& shadows, const py::object& filter) {
   using namespace vox;
   RenderOptions ro;
-  ro.mode = parseRenderMode(mode);
-  const AccelKind accelKind = parseAccel(accelName);
-  if (!py::isinstance<py::sequence>(size) || py::len(size) != 2) fail<UsageError>("size must be (width, height)");
-  const py::sequence wh = py::reinterpret_borrow<py::sequence>(size);
-  ro.width = uintArg<uint32_t>(wh[0], "width", 1, kMaxSide);
-  ro.height = uintArg<uint32_t>(wh[1], "height", 1, kMaxSide);
+  ro.mode = enumArg(mode, "mode", parseRenderMode);
+  const auto wh = sequenceArg(size, "size", 2, "(width, height)");
+  ro.width = uint32_t(intArg(wh[0], "size: width", 1, kMaxSide));
+  ro.height = uint32_t(intArg(wh[1], "size: height", 1, kMaxSide));
   if (uint64_t(ro.width) * ro.height > kMaxPixels) fail<UsageError>("size: at most 2^28 pixels");
-  ro.samples = uintArg<uint32_t>(samples, "samples", 1, kMaxSamples);
-  ro.bounces = uintArg<uint32_t>(bounces, "bounces", 0, kMaxBounces);
-  if (!(std::isfinite(weight) && weight >= 0)) fail<UsageError>("weight must be a finite number >= 0");
-  ro.weight = weight;
-  ro.shadeBack = shadeBack;
-  ro.shadows = shadows;
+  ro.samples = uint32_t(intArg(samples, "samples", 1, kMaxSamples));
+  ro.bounces = uint32_t(intArg(bounces, "bounces", 0, kMaxBounces));
+  ro.weight = floatArg(weight, "weight");
+  if (!(ro.weight >= 0)) fail<UsageError>("weight must be a finite number >= 0, got ", ro.weight);
+  ro.shadeBack = boolArg(shadeBack, "shade_back");
+  ro.shadows = boolArg(shadows, "shadows");
   if (!filter.is_none()) {
-    if (!py::isinstance<py::sequence>(filter) || py::isinstance<py::str>(filter) || py::len(filter) != 2)
-      fail<UsageError>("filter must be (kind, radius): ('box' | 'tent' | 'gaussian', pixels)");
-    const py::sequence f = py::reinterpret_borrow<py::sequence>(filter);
-    ro.filter = parseFilter(f[0].cast<std::string>());
-    ro.filterRadius = f[1].cast<double>();
+    const auto f = sequenceArg(filter, "filter", 2, "(kind, radius): ('box' | 'tent' | 'gaussian', pixels)");
+    ro.filter = enumArg(f[0], "filter kind", parseFilter);
+    ro.filterRadius = floatArg(f[1], "filter radius");
     if (!(ro.filterRadius > 0 && ro.filterRadius <= kMaxFilterRadius))
-      fail<UsageError>("filter radius must be in (0, ", kMaxFilterRadius, "] pixels");
+      fail<UsageError>("filter radius must be in (0, ", kMaxFilterRadius, "] pixels, got ", ro.filterRadius);
   }
+  return ro;
+}
+
+py::array_t<float> render(PyGrid& self, const py::object& size, const py::object& mode, const py::object& samples,
+                          const py::object& bounces, const py::object& weight, const py::object& shadeBack,
+                          const py::object& shadows, const py::object& filter, const py::object& eye,
+                          const py::object& lookAt, const py::object& up, const py::object& fov,
+                          const py::object& accelName, const py::object& threads, const py::object& progress) {
+  using namespace vox;
+  RenderOptions ro = renderOptions(size, mode, samples, bounces, weight, shadeBack, shadows, filter);
+  const AccelKind accelKind = enumArg(accelName, "accel", parseAccel);
   ro.camera = resolveCamera(self, eye, lookAt, up, fov);
   const auto nThreads = threadsArg(threads);
   const bool single = ro.mode == RenderMode::Count || ro.mode == RenderMode::Depth;
@@ -107,24 +130,37 @@ py::array_t<float> render(PyGrid& self, const py::object& size, const std::strin
   return adoptVector<float>(std::move(image.pixels), shape);
 }
 
+std::string shapeText(const py::array& a) {
+  std::ostringstream out;
+  out << "(";
+  for (py::ssize_t d = 0; d < a.ndim(); ++d) out << (d ? ", " : "") << a.shape(d);
+  out << (a.ndim() == 1 ? ",)" : ")");
+  return out.str();
+}
+
 void saveImage(const py::object& pathObj, const py::handle& pixels) {
-  const auto path = pathArg(pathObj);
-  if (!path) throw py::type_error("path must be a str or os.PathLike");
-  const auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(pixels);
-  if (!a) throw py::type_error("image must be an array of numbers");
+  const std::string path = pathArg(pathObj, "path");
+  const py::array raw = asArray(pixels, "image");
+  const char kind = raw.dtype().kind();
+  if (!((kind == 'f' && raw.dtype().itemsize() <= 8) || kind == 'i' || kind == 'u'))
+    failType("image must hold numbers (floats or integers), not ", std::string(py::str(raw.dtype())));
+  const auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(raw);
   const bool depth = a.ndim() == 2 || (a.ndim() == 3 && a.shape(2) == 1);
   if (!(depth || (a.ndim() == 3 && a.shape(2) == 3)) || a.shape(0) == 0 || a.shape(1) == 0)
-    vox::fail<vox::InputError>("image: expected shape (H, W, 3) or (H, W), got ", a.ndim(), " dimensions");
-  if (!vox::imageFormatSupported(*path))
-    vox::fail<vox::UsageError>(*path, ": unknown image format (use an extension such as .png, .tga, .exr, .jpg)");
+    vox::fail<vox::InputError>("image: expected shape (H, W, 3) or (H, W) with H and W at least 1, got shape ",
+                               shapeText(a));
+  if (a.shape(0) > kMaxSide || a.shape(1) > kMaxSide)
+    vox::fail<vox::InputError>("image: at most ", kMaxSide, " pixels a side, got shape ", shapeText(a));
+  if (!vox::imageFormatSupported(path))
+    vox::fail<vox::UsageError>("path: ", path, ": unknown image format (use an extension such as .png, .tga, .exr, .jpg)");
   vox::Image image;
   image.height = uint32_t(a.shape(0));
   image.width = uint32_t(a.shape(1));
   image.channels = depth ? 1 : 3;
   image.pixels.assign(a.data(), a.data() + a.size());
   py::gil_scoped_release release;
-  if (depth && !vox::imageFormatHoldsFloat(*path)) image = vox::depthToGrey(image);
-  vox::writeImage(*path, image);
+  if (depth && !vox::imageFormatHoldsFloat(path)) image = vox::depthToGrey(image);
+  vox::writeImage(path, image);
 }
 
 }  // namespace

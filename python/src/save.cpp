@@ -27,10 +27,6 @@ bool isViewerPagePath(const std::string& path) {
   return lowerExtension(path) == ".html" || lowerExtension(path) == ".htm";
 }
 
-void warn(const std::string& message) {
-  if (PyErr_WarnEx(PyExc_UserWarning, message.c_str(), 1) != 0) throw py::error_already_set();
-}
-
 // A grid set of the grid (vox-voxelize --bricks): the set's writer voxelizes the grid's scene brick by brick under
 // the grid's own plan (bounds, dims, method; the fill when the grid has solid cells), which gives the grid's cells
 // (grid_set.h: a brick holds exactly the single grid's cells); the totals are checked against the grid's.
@@ -60,12 +56,13 @@ void saveGridSet(const PyGrid& self, const std::string& path, const std::array<u
                                "): it cannot be written as a grid set");
 }
 
-void save(PyGrid& self, const py::object& pathObj, const std::string& facesName, const std::string& colorName,
-          bool ascii, const py::object& bricksArg, const py::object& threads, const py::object& progress) {
-  const auto path = pathArg(pathObj);
-  if (!path) throw py::type_error("path must be a str or os.PathLike");
-  const vox::FaceMode faces = optionArg("faces", facesName, vox::parseFaceMode);
-  const vox::ColorMode color = optionArg("color", colorName, vox::parseColorMode);
+void save(PyGrid& self, const py::object& pathObj, const py::object& facesName, const py::object& colorName,
+          const py::object& asciiArg, const py::object& bricksArg, const py::object& threads,
+          const py::object& progress) {
+  const std::optional<std::string> path = pathArg(pathObj, "path");
+  const vox::FaceMode faces = enumArg(facesName, "faces", vox::parseFaceMode);
+  const vox::ColorMode color = enumArg(colorName, "color", vox::parseColorMode);
+  const bool ascii = boolArg(asciiArg, "ascii");
   const auto nThreads = threadsArg(threads);
   // As the tools: an output that is the grid's own file is refused, a missing folder reported, before any work.
   std::vector<std::string> inputs;
@@ -77,7 +74,7 @@ void save(PyGrid& self, const py::object& pathObj, const std::string& facesName,
   std::optional<std::array<uint32_t, 3>> bricks;
   if (!bricksArg.is_none()) {
     if (!gridFile) vox::fail<vox::UsageError>("bricks: only a .vgrid output is written as a grid set");
-    bricks = dims3Arg(bricksArg, "bricks");
+    bricks = dims3Arg(bricksArg, "bricks", UINT32_MAX);
     vox::checkBrickCounts(self.grid().dims, *bricks);
   }
   vox::checkOutputPath(*path, inputs);

@@ -18,9 +18,10 @@ namespace {
 
 // A voxelize source: a scene file to read (with the GIL released), or a scene made from arrays.
 struct Source {
-  std::optional<std::string> path;
+  std::optional<std::string> path;  // file system bytes
   vox::Scene scene;
-  std::string name;  // the path, or "<arrays>"
+  std::string name;   // the path, or "<arrays>"
+  std::string label;  // what messages start with: "" for voxelize's source, "sources[i]: " in a batch
 
   const vox::Scene& load() {
     if (path) {
@@ -29,52 +30,66 @@ struct Source {
     }
     return scene;
   }
+  // A message about this source: the label, then the path unless the message names it already (the importers'
+  // messages and warnings start with it), so that no message says the path twice.
+  std::string describe(const std::string& message) const {
+    if (name != "<arrays>" && message.rfind(name, 0) == 0) return label + message;
+    if (name == "<arrays>" && !label.empty()) return label + message;
+    return label + name + ": " + message;
+  }
 };
 
-Source sourceArg(const py::handle& obj, const std::string& what) {
+// obj.<attr>, or a null object when it has none; any other exception of the attribute (a property that raises)
+// propagates as it is.
+py::object attrOrNull(const py::handle& obj, const char* attr) {
+  PyObject* value = PyObject_GetAttrString(obj.ptr(), attr);
+  if (value) return py::reinterpret_steal<py::object>(value);
+  if (!PyErr_ExceptionMatches(PyExc_AttributeError)) throw py::error_already_set();
+  PyErr_Clear();
+  return py::object();
+}
+
+// A scene from arrays, its InputError and LimitError prefixed with the label (a batch says which source).
+vox::Scene arraysScene(const py::handle& vertices, const py::handle& faces, const std::string& label) {
+  try {
+    return sceneFromArrays(vertices, faces);
+  } catch (const vox::InputError& e) {
+    if (label.empty()) throw;
+    throw vox::InputError(label + e.what());
+  } catch (const vox::LimitError& e) {
+    if (label.empty()) throw;
+    throw vox::LimitError(label + e.what());
+  }
+}
+
+// `what` names the argument in messages ("source", "sources[3]"); `label` as Source::label.
+Source sourceArg(const py::handle& obj, const std::string& what, const std::string& label) {
   Source s;
   s.name = "<arrays>";
+  s.label = label;
   if ((py::isinstance<py::tuple>(obj) || py::isinstance<py::list>(obj)) && py::len(obj) == 2) {
     const py::sequence pair = py::reinterpret_borrow<py::sequence>(obj);
-    s.scene = sceneFromArrays(pair[0], pair[1]);
-  } else if (auto p = pathArg(obj)) {
-    s.path = *p;
-    s.name = *p;
-    if (p->size() > 6 && p->compare(p->size() - 6, 6, ".vgrid") == 0)
-      vox::fail<vox::UsageError>(*p, ": a grid file, not a scene: libvox.load reads it");
-  } else if (py::hasattr(obj, "vertices") && py::hasattr(obj, "faces")) {
-    s.scene = sceneFromArrays(obj.attr("vertices"), obj.attr("faces"));
-  } else {
-    throw py::type_error(what +
-                         " must be a path, a (vertices, faces) pair or an object with .vertices and .faces, not " +
-                         std::string(py::str(py::type::of(obj).attr("__name__"))));
+    s.scene = arraysScene(pair[0], pair[1], label);
+    return s;
   }
+  if (isPath(obj)) {
+    s.path = pathArg(obj, what);
+    s.name = *s.path;
+    const std::string& p = *s.path;
+    if (p.size() > 6 && p.compare(p.size() - 6, 6, ".vgrid") == 0)
+      vox::fail<vox::UsageError>(label, p, ": a grid file, not a scene: libvox.load reads it");
+    return s;
+  }
+  const py::object vertices = attrOrNull(obj, "vertices");
+  const py::object faces = vertices ? attrOrNull(obj, "faces") : py::object();
+  if (!vertices || !faces)
+    failType(what, " must be a path, a (vertices, faces) pair or an object with .vertices and .faces, not ",
+             typeName(obj));
+  s.scene = arraysScene(vertices, faces, label);
   return s;
 }
 
-vox::OverlapMethod methodArg(const std::string& name) {
-  try {
-    return vox::parseMethod(name);
-  } catch (const vox::InputError& e) {
-    throw vox::UsageError(std::string("method: ") + e.what());
-  }
-}
-
-uint32_t resolutionArg(const py::object& obj, const char* name) {
-  if (py::isinstance<py::bool_>(obj) || !py::isinstance<py::int_>(obj))
-    throw py::type_error(std::string(name) + " must be an int, not " +
-                         std::string(py::str(py::type::of(obj).attr("__name__"))));
-  const long long n = obj.cast<long long>();
-  if (n < 1 || n > vox::kMaxCellsPerAxis)
-    vox::fail<vox::UsageError>(name, " must be 1..", vox::kMaxCellsPerAxis, ", got ", n);
-  return uint32_t(n);
-}
-
-bool fillArg(const py::object& fill) {
-  if (fill.is_none()) return false;
-  if (!py::isinstance<py::bool_>(fill)) throw py::type_error("fill must be None or a bool");
-  return fill.cast<bool>();
-}
+bool fillArg(const py::object& fill) { return boolArg(fill, "fill", true); }
 
 // pitch: cells of that edge length (per axis when three numbers): dims = ceil(extent / pitch), the bounds grown
 // symmetrically to whole cells (DESIGN.md "Python").
@@ -103,42 +118,44 @@ void applyPitch(const Pitch& pitch, const vox::Scene& scene, vox::VoxelizeOption
   vo.dims = dims;
 }
 
-void warn(const std::string& message) {
-  if (PyErr_WarnEx(PyExc_UserWarning, message.c_str(), 1) != 0) throw py::error_already_set();
-}
-
-// The library's LimitError and InputError of a voxelization named with the scene, as vox-voxelize names them.
+// The library's errors of a voxelization named with the source, as vox-voxelize names them: LimitError and
+// InputError always, UsageError too in a batch (where the options are the same for every source and a failing
+// plan is the source's).
 template <class Work>
-auto namedAfter(const std::string& name, Work&& work) -> decltype(work()) {
+auto namedAfter(const Source& src, Work&& work) -> decltype(work()) {
   try {
     return work();
   } catch (const vox::LimitError& e) {
-    vox::fail<vox::LimitError>(name, ": ", e.what());
+    throw vox::LimitError(src.describe(e.what()));
   } catch (const vox::InputError& e) {
-    if (std::string(e.what()).rfind(name, 0) == 0) throw;  // the importers name the file already
-    vox::fail<vox::InputError>(name, ": ", e.what());
+    throw vox::InputError(src.describe(e.what()));
+  } catch (const vox::UsageError& e) {
+    if (src.label.empty()) throw;
+    throw vox::UsageError(src.label + e.what());
   }
 }
 
+// pitch: one positive number, or three.
+vox::Vec3 pitchArg(const py::object& pitch) {
+  const vox::Vec3 size = isSequence(pitch) ? vec3Arg(pitch, "pitch") : vox::Vec3{1, 1, 1} * floatArg(pitch, "pitch");
+  for (int a = 0; a < 3; ++a)
+    if (!(size[a] > 0)) vox::fail<vox::UsageError>("pitch must be positive, got ", size[a]);
+  return size;
+}
+
 std::shared_ptr<PyGrid> voxelize(const py::object& source, const py::object& resolution, const py::object& dims,
-                                 const py::object& pitch, const py::object& bounds, const std::string& method,
+                                 const py::object& pitch, const py::object& bounds, const py::object& method,
                                  const py::object& fill, const py::object& threads, const py::object& progress) {
-  Source src = sourceArg(source, "source");
+  Source src = sourceArg(source, "source", "");
   vox::VoxelizeOptions vo;
-  vo.method = methodArg(method);
+  vo.method = enumArg(method, "method", vox::parseMethod);
   const int given = int(!resolution.is_none()) + int(!dims.is_none()) + int(!pitch.is_none());
   if (given > 1) vox::fail<vox::UsageError>("give at most one of resolution, dims and pitch");
-  if (!resolution.is_none()) vo.resolution = resolutionArg(resolution, "resolution");
-  if (!dims.is_none()) vo.dims = dims3Arg(dims, "dims");
+  if (!resolution.is_none()) vo.resolution = uint32_t(intArg(resolution, "resolution", 1, vox::kMaxCellsPerAxis));
+  if (!dims.is_none()) vo.dims = dims3Arg(dims, "dims", vox::kMaxCellsPerAxis);
   if (!bounds.is_none()) vo.bounds = boxArg(bounds, "bounds");
   std::optional<Pitch> pitchSize;
-  if (!pitch.is_none()) {
-    const py::array p = py::array::ensure(pitch);
-    const vox::Vec3 size = p && p.ndim() == 0 ? vox::Vec3{1, 1, 1} * pitch.cast<double>() : vec3Arg(pitch, "pitch");
-    if (!(size.x > 0 && size.y > 0 && size.z > 0 && vox::isFinite(size)))
-      vox::fail<vox::UsageError>("pitch must be positive and finite");
-    pitchSize = Pitch{size};
-  }
+  if (!pitch.is_none()) pitchSize = Pitch{pitchArg(pitch)};
   const bool doFill = fillArg(fill);
   const auto nThreads = threadsArg(threads);
   vo.memoryLimitBytes = memoryBudget();
@@ -148,7 +165,7 @@ std::shared_ptr<PyGrid> voxelize(const py::object& source, const py::object& res
   vox::Grid grid = runLong(interrupt, nThreads, [&] {
     const vox::Scene& scene = src.load();
     if (pitchSize) applyPitch(*pitchSize, scene, vo);
-    return namedAfter(src.name, [&] {
+    return namedAfter(src, [&] {
       vox::Grid g = vox::voxelizeScene(scene, vo);
       if (doFill) {
         vox::FillOptions fo;
@@ -159,9 +176,9 @@ std::shared_ptr<PyGrid> voxelize(const py::object& source, const py::object& res
       return g;
     });
   });
-  for (const std::string& w : src.scene.warnings) warn(src.name + ": " + w);
+  for (const std::string& w : src.scene.warnings) warn(src.describe(w));
   if (doFill)
-    if (const std::string w = vox::fillWarning(report); !w.empty()) warn(src.name + ": fill: " + w);
+    if (const std::string w = vox::fillWarning(report); !w.empty()) warn(src.describe("fill: " + w));
   return std::make_shared<PyGrid>(vox::GridFile{std::move(src.scene), std::move(grid)}, src.name);
 }
 
@@ -187,17 +204,38 @@ vox::Box batchCube(const vox::Box& b) {
   return cube;
 }
 
-py::object voxelizeBatch(const py::iterable& sources, const py::object& resolution, const py::object& fill,
-                         const std::string& method, const py::object& threads, bool dense, const py::object& progress) {
-  std::vector<Source> srcs;
-  size_t index = 0;
-  for (const py::handle s : sources) {
-    srcs.push_back(sourceArg(s, "sources[" + std::to_string(index) + "]"));
-    ++index;
+// The sources of a batch: an iterable of sources, not one source (a str would be iterated letter by letter).
+// Converting many arrays takes a while with the GIL held: Ctrl-C is looked at after each.
+std::vector<Source> sourcesArg(const py::object& sources) {
+  constexpr const char* kWhat =
+      "sources must be a list of sources (paths, (vertices, faces) pairs or objects with .vertices and .faces), not ";
+  if (isPath(sources)) failType(kWhat, typeName(sources), " (for one source: voxelize_batch([source], ...))");
+  PyObject* iter = PyObject_GetIter(sources.ptr());
+  if (!iter) {
+    if (!PyErr_ExceptionMatches(PyExc_TypeError)) throw py::error_already_set();
+    PyErr_Clear();
+    failType(kWhat, typeName(sources));
   }
-  const uint32_t r = resolutionArg(resolution, "resolution");
-  const vox::OverlapMethod m = methodArg(method);
+  const py::object it = py::reinterpret_steal<py::object>(iter);
+  std::vector<Source> srcs;
+  while (PyObject* item = PyIter_Next(it.ptr())) {
+    const py::object s = py::reinterpret_steal<py::object>(item);
+    const std::string what = "sources[" + std::to_string(srcs.size()) + "]";
+    srcs.push_back(sourceArg(s, what, what + ": "));
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+  }
+  if (PyErr_Occurred()) throw py::error_already_set();
+  return srcs;
+}
+
+py::object voxelizeBatch(const py::object& sources, const py::object& resolution, const py::object& fill,
+                         const py::object& method, const py::object& threads, const py::object& denseArg,
+                         const py::object& progress) {
+  std::vector<Source> srcs = sourcesArg(sources);
+  const uint32_t r = uint32_t(intArg(resolution, "resolution", 1, vox::kMaxCellsPerAxis));
+  const vox::OverlapMethod m = enumArg(method, "method", vox::parseMethod);
   const bool doFill = fillArg(fill);
+  const bool dense = boolArg(denseArg, "dense");
   const auto nThreads = threadsArg(threads);
   const uint64_t budget = memoryBudget();
   const uint64_t cube = uint64_t(r) * r * r;
@@ -209,14 +247,14 @@ py::object voxelizeBatch(const py::iterable& sources, const py::object& resoluti
     cells = out.mutable_data();
   }
   std::vector<vox::Grid> grids(dense ? 0 : srcs.size());
+  std::vector<vox::FillReport> reports(srcs.size());
   Interrupt interrupt(progressCallable(progress, "voxelizing"));
   std::atomic<size_t> done{0};
   runLong(interrupt, nThreads, [&] {
     tbb::parallel_for(size_t(0), srcs.size(), [&](size_t b) {
       if (interrupt.cancelled()) return;
       Source& src = srcs[b];
-      const std::string name = "sources[" + std::to_string(b) + "] (" + src.name + ")";
-      vox::Grid g = namedAfter(name, [&] {
+      vox::Grid g = namedAfter(src, [&] {
         const vox::Scene& scene = src.load();
         vox::VoxelizeOptions vo;
         vo.method = m;
@@ -229,7 +267,7 @@ py::object voxelizeBatch(const py::iterable& sources, const py::object& resoluti
           vox::FillOptions fo;
           fo.memoryLimitBytes = budget;
           fo.progress = vo.progress;
-          vox::fillSolid(g, scene, fo);
+          reports[b] = vox::fillSolid(g, scene, fo);
         }
         return g;
       });
@@ -246,6 +284,12 @@ py::object voxelizeBatch(const py::iterable& sources, const py::object& resoluti
     });
     if (interrupt.cancelled()) vox::fail<vox::Error>("voxelize_batch cancelled");
   });
+  // The warnings voxelize gives, each source's in turn, named by its index.
+  for (size_t b = 0; b < srcs.size(); ++b) {
+    for (const std::string& w : srcs[b].scene.warnings) warn(srcs[b].describe(w));
+    if (doFill)
+      if (const std::string w = vox::fillWarning(reports[b]); !w.empty()) warn(srcs[b].describe("fill: " + w));
+  }
   if (dense) return out;
   py::list list;
   for (size_t b = 0; b < srcs.size(); ++b)

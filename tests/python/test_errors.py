@@ -32,7 +32,7 @@ def test_exception_hierarchy():
     (V, [[0, -1, 2]], libvox.InputError, r"faces\[0, 1\] = -1: out of range"),
     (np.empty((0, 3)), np.empty((0, 3), dtype=int), libvox.InputError, "vertices: empty array"),
     (V, np.empty((0, 3), dtype=int), libvox.InputError, "faces: empty array"),
-    (np.array([[2.0 ** 60, 0, 0]], dtype=np.int64).repeat(3, 0), F, libvox.InputError, "has no exact double"),
+    (np.array([[2 ** 60 + 1, 0, 0]], dtype=np.int64).repeat(3, 0), F, libvox.InputError, "has no exact double"),
 ])
 def test_bad_arrays(vertices, faces, error, message):
     with pytest.raises(error, match=message):

@@ -16,6 +16,7 @@
 #include <array>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <memory>
 #include <span>
 #include <vector>
@@ -68,9 +69,15 @@ struct Block {
 inline constexpr size_t kParallelSortFrom = size_t(1) << 16;
 
 // The keys of all `parts`, sorted ascending on their low `bits` bits (stable). Returns the array and its size.
+// `check` (may be empty) is called between tasks of the parallel sort, from any thread; it throws to cancel (a sort
+// of 20 M keys takes half a second, too long for Ctrl-C to wait).
 inline std::pair<HugeArray<uint64_t>, size_t> radixSortParts(std::span<const std::span<const uint64_t>> parts, int bits,
-                                                             size_t parallelFrom = kParallelSortFrom) {
+                                                             size_t parallelFrom = kParallelSortFrom,
+                                                             const std::function<void()>& check = {}) {
   using namespace radix_detail;
+  const auto poll = [&] {
+    if (check) check();
+  };
   size_t n = 0;
   for (const auto& p : parts) n += p.size();
   // Not zeroed, on whole huge pages: malloc'd and advised, 2 x 41 MB for the bunny at 1024^3 still took a
@@ -95,6 +102,7 @@ inline std::pair<HugeArray<uint64_t>, size_t> radixSortParts(std::span<const std
       blocks.push_back({p.data() + i, std::min(blockSize, p.size() - i)});
   std::vector<Counts> count(blocks.size());
   tbb::parallel_for(size_t(0), blocks.size(), [&](size_t k) {
+    poll();
     count[k].fill(0);
     for (size_t i = 0; i < blocks[k].size; ++i) ++count[k][(blocks[k].keys[i] >> shift) & topMask];
   });
@@ -110,7 +118,9 @@ inline std::pair<HugeArray<uint64_t>, size_t> radixSortParts(std::span<const std
     bucketStart[d] = sum;
   }
   exclusiveSum(bucketStart);
+  poll();
   tbb::parallel_for(size_t(0), blocks.size(), [&](size_t k) {
+    poll();
     Counts& c = count[k];
     for (size_t d = 0; d < kBuckets; ++d) c[d] += bucketStart[d];
     for (size_t i = 0; i < blocks[k].size; ++i) {
@@ -120,6 +130,7 @@ inline std::pair<HugeArray<uint64_t>, size_t> radixSortParts(std::span<const std
   });
   if (shift > 0) {
     tbb::parallel_for(size_t(0), kBuckets, [&](size_t d) {
+      if (d % 64 == 0) poll();
       const size_t begin = bucketStart[d], end = d + 1 < kBuckets ? bucketStart[d + 1] : n;
       // A bucket smaller than a digit's counts sorts faster by comparison (stable, on the low bits only).
       if (end - begin < kBuckets / 4) {

@@ -17,6 +17,8 @@ voxelize: core
 trace: core
 export: core io
 sets: core io voxelize
+distance: core voxelize
+volume: core voxelize
 '
 
 files=()

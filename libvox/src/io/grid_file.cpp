@@ -96,6 +96,8 @@ const std::vector<SectionCodec>& sectionCodecs() {
       {SectionTag::SolidTextures, "solid textures", hasSolidTexturesSection, putSolidTexturesSection,
        getSolidTexturesSection},
       {SectionTag::CameraSpan, "camera span", hasCameraSpanSection, putCameraSpanSection, getCameraSpanSection},
+      {SectionTag::Distances, "distances", hasDistancesSection, putDistancesSection, getDistancesSection},
+      {SectionTag::Fractions, "fractions", hasFractionsSection, putFractionsSection, getFractionsSection},
   };
   return codecs;
 }
@@ -227,13 +229,20 @@ std::string encodeHeader(uint64_t payloadSize, uint64_t checksum, uint32_t versi
 // Runs the encoder with every byte going to `sink`.
 void streamPayload(const Scene& scene, const Grid& grid, const EncodedCellTable& table, const ByteWriter::Sink& sink) {
   ByteWriter w(sink);
-  encodePayload(w, scene, grid, table, kGridFileVersion);
+  encodePayload(w, scene, grid, table, gridFileVersionFor(grid));
   w.finish();
 }
 
 }  // namespace
 
+uint32_t gridFileVersionFor(const Grid& grid) {
+  return grid.sdfHalfWidth > 0 || !grid.fractions.empty() ? 4 : 3;
+}
+
 std::string encodeGridFile(const Scene& scene, const Grid& grid, uint32_t version) {
+  if (version == 0) version = gridFileVersionFor(grid);
+  if (version < gridFileVersionFor(grid) && version >= 3)
+    fail<UsageError>("grid file version ", version, " cannot hold distances or volume fractions");
   if (version < 2 || version > kGridFileVersion) fail<UsageError>("cannot write grid file version ", version);
   const EncodedCellTable table = version >= 3 ? encodeCellTable(grid) : EncodedCellTable{};
   const uint64_t cellBytes = version >= 3 ? table.bytes.size() : grid.cellKeys.size() * 16 + grid.primIds.size() * 4;
@@ -410,6 +419,8 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
     grid.solidRuns = r.getArray<CellRun>("solid run");
     checkSolidRuns(grid.solidRuns, cells, name + ": solid runs at byte " + std::to_string(runsAt));
     getSections(r, scene, grid);
+    if (version < gridFileVersionFor(grid))
+      fail<InputError>(name, ": distances or volume fractions in a version ", version, " file (they need version 4)");
   }
   if (version < 3) checkFlatCellTable(grid, bounded, name, cellsAt);
   checkSolidRunsMissCells(grid.cellKeys, grid.solidRuns, name + ": solid runs");
@@ -431,7 +442,7 @@ void writeGridFile(const std::string& path, const Scene& scene, const Grid& grid
   ChecksumStream sum(size);
   streamPayload(scene, grid, table, [&](std::string_view bytes) { sum.update(bytes); });
   OutputFile out(path);
-  out.write(encodeHeader(size, sum.value()));
+  out.write(encodeHeader(size, sum.value(), gridFileVersionFor(grid)));
   streamPayload(scene, grid, table, [&](std::string_view bytes) { out.write(bytes); });
   out.flush();
   const auto written = Clock::now();

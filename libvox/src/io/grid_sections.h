@@ -15,7 +15,14 @@
 
 namespace vox {
 
-enum class SectionTag : uint32_t { Textures = 1, SolidTextures = 2, Brick = 3, CameraSpan = 4 };
+enum class SectionTag : uint32_t {
+  Textures = 1,
+  SolidTextures = 2,
+  Brick = 3,
+  CameraSpan = 4,
+  Distances = 5,  // grid file version 4
+  Fractions = 6,  // grid file version 4
+};
 
 struct SectionCodec {
   SectionTag tag;
@@ -39,5 +46,15 @@ void getSolidTexturesSection(ByteReader& r, Scene& scene, Grid& grid);
 bool hasCameraSpanSection(const Scene& scene, const Grid& grid);
 void putCameraSpanSection(ByteWriter& w, const Scene& scene, const Grid& grid);
 void getCameraSpanSection(ByteReader& r, Scene& scene, Grid& grid);
+
+// Distances (io/grid_section_distances.cpp): the --sdf band's cell keys and signed distances.
+bool hasDistancesSection(const Scene& scene, const Grid& grid);
+void putDistancesSection(ByteWriter& w, const Scene& scene, const Grid& grid);
+void getDistancesSection(ByteReader& r, Scene& scene, Grid& grid);
+
+// Fractions (io/grid_section_fractions.cpp): --fraction's volume fraction of each occupied cell.
+bool hasFractionsSection(const Scene& scene, const Grid& grid);
+void putFractionsSection(ByteWriter& w, const Scene& scene, const Grid& grid);
+void getFractionsSection(ByteReader& r, Scene& scene, Grid& grid);
 
 }  // namespace vox

@@ -1,5 +1,6 @@
 #include "vox/voxelize/winding_number.h"
 
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
@@ -80,8 +81,20 @@ void buildNode(WindingTree& tree, const BuildInput& in, std::vector<uint32_t>& o
 double triangleWindingNumber(const Vec3& a0, const Vec3& b0, const Vec3& c0, const Vec3& q) {
   const Vec3 a = a0 - q, b = b0 - q, c = c0 - q;
   const double la = length(a), lb = length(b), lc = length(c);
-  const double num = dot(a, cross(b, c));
-  if (num == 0) return 0;  // q in the triangle's plane (off the triangle: an empty cell's centre) or degenerate
+  double num = dot(a, cross(b, c));
+  // Near the triangle's plane the rounded triple product can take the wrong sign, and over the triangle's interior
+  // that flips its term from +1/2 to -1/2: a point a hair inside a closed surface would count as outside. There the
+  // sign comes from CGAL's exact orientation predicate (filtered: exact for double input); num's magnitude only
+  // matters far from the jump. The bound is loose on purpose: rounding errs by a few ulps of la lb lc.
+  if (std::fabs(num) <= 1e-12 * la * lb * lc) {
+    using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+    const auto point = [](const Vec3& v) { return K::Point_3(v.x, v.y, v.z); };
+    // det(a0 - q, b0 - q, c0 - q) = -det(b0 - a0, c0 - a0, q - a0), CGAL's orientation(a0, b0, c0, q).
+    const int exact = -int(CGAL::orientation(point(a0), point(b0), point(c0), point(q)));
+    if (exact == 0) return 0;  // q exactly in the triangle's plane (on it: on the surface) or degenerate
+    num = std::copysign(std::max(std::fabs(num), 1e-300), double(exact));
+  }
+  if (num == 0) return 0;
   const double den = la * lb * lc + dot(a, b) * lc + dot(a, c) * lb + dot(b, c) * la;
   return 2 * std::atan2(num, den) * kInv4Pi;
 }

@@ -42,6 +42,15 @@ struct Grid {
   // Cells inside the surface (--fill): sorted, disjoint, non-adjacent runs of keys. They hold no primitive; a cell
   // may be both occupied and solid (tracing and export treat it as occupied).
   std::vector<CellRun> solidRuns;
+  // Signed distances (--sdf, DESIGN.md "Distance and volume"): the sorted keys of the cells whose centre lies within
+  // sdfHalfWidth smallest cell edges of the surface, and the signed distance at each centre (negative inside).
+  // Empty, with sdfHalfWidth 0, when not computed.
+  double sdfHalfWidth = 0;
+  std::vector<uint64_t> sdfKeys;
+  std::vector<double> sdfValues;
+  // Volume fractions (--fraction): for each occupied cell (the order of cellKeys), the fraction of its closed box
+  // inside the solid, in [0, 1]. Empty when not computed; solid cells count 1 without an entry.
+  std::vector<double> fractions;
 
   uint64_t cellCount() const { return uint64_t(dims[0]) * dims[1] * dims[2]; }
   size_t occupiedCount() const { return cellKeys.size(); }

@@ -9,9 +9,14 @@
 
 namespace vox {
 
-// Version 3: the cell table delta-coded (a quarter of version 2's bytes at 1024^3). Version 2 (solid cells as
-// runs, optional tagged sections) and version 1 files still read.
-inline constexpr uint32_t kGridFileVersion = 3;
+// Version 4: the Distances and Fractions sections (--sdf, --fraction). A grid without them is still written as
+// version 3, byte for byte what earlier builds wrote and read. Version 3: the cell table delta-coded (a quarter of
+// version 2's bytes at 1024^3). Version 2 (solid cells as runs, optional tagged sections) and version 1 files still
+// read.
+inline constexpr uint32_t kGridFileVersion = 4;
+
+// The version a grid is written in: 4 when it holds distances or fractions, 3 otherwise.
+uint32_t gridFileVersionFor(const Grid& grid);
 
 struct GridFile {
   Scene scene;
@@ -37,8 +42,9 @@ uint64_t gridChecksum(const char* payload, size_t size);
 
 // The same on bytes in memory (fuzzing, tests). `name` is used in error messages. `version` 2 writes the previous
 // layout, for tests that old files still read. The grid must be well-formed (every cell's offsets inside primIds,
-// as voxelizeScene and decodeGridFile make it): version 3's encoder reads each cell's ids.
-std::string encodeGridFile(const Scene& scene, const Grid& grid, uint32_t version = kGridFileVersion);
+// as voxelizeScene and decodeGridFile make it): version 3's encoder reads each cell's ids. Version 0: the one
+// gridFileVersionFor names.
+std::string encodeGridFile(const Scene& scene, const Grid& grid, uint32_t version = 0);
 GridFile decodeGridFile(const std::string& bytes, const std::string& name);
 
 }  // namespace vox

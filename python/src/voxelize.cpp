@@ -332,7 +332,11 @@ would not fit in memory, checked before allocating), TypeError (wrong argument t
 Voxelizes many meshes, spread over worker threads: each source (as for voxelize) in its own cubic grid of
 `resolution` cells per axis over its own bounds (cubic cells: the longest axis spans the mesh exactly, the others
 are centred on it). Returns np.bool_ of shape (B, R, R, R) indexed [b, i, j, k] (occupied and solid cells), or a
-list of Grids when dense=False. Errors name the source's index.
+list of Grids when dense=False.
+
+sources: a list (or any iterable) of sources; one path alone is a TypeError (voxelize_batch([path], ...)).
+Errors and the importers' warnings of a source start with its index: "sources[1]: faces[0, 2] = 10: ...".
+Raises as voxelize does; Ctrl-C raises KeyboardInterrupt within a fraction of a second.
 )doc");
 }
 

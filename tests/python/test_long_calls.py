@@ -35,6 +35,8 @@ MOMENTS = textwrap.dedent("""
     def call():
         if what == "voxelize":
             libvox.voxelize(path, resolution=2048)
+        elif what == "fill":  # the fill's serial phases: its row table, flood links and run groups
+            libvox.voxelize(path, resolution=1024, fill=True)
         elif what == "batch":
             libvox.voxelize_batch([(V, F)] * 64, 256)
         else:
@@ -66,9 +68,10 @@ MOMENTS = textwrap.dedent("""
 """)
 
 
-@pytest.mark.parametrize("what", ["voxelize", "batch"])
+@pytest.mark.parametrize("what", ["voxelize", "fill", "batch"])
 def test_ctrl_c_within_half_a_second(what):
-    """voxelize of the bunny at 2048^3 and voxelize_batch of 64 bunnies at 256^3, each interrupted at 10 moments."""
+    """voxelize of the bunny at 2048^3, with fill at 1024^3, and voxelize_batch of 64 bunnies at 256^3, each
+    interrupted at 10 moments."""
     proc = subprocess.run([sys.executable, "-c", MOMENTS, what, str(BUNNY_PLY)], capture_output=True, text=True,
                           timeout=300)
     assert proc.returncode == 0, proc.stderr

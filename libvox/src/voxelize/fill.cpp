@@ -60,14 +60,27 @@ struct Interval {
   uint64_t slot;    // the run's slot (firstSlot)
 };
 
+// Asks FillOptions::progress whether to go on, from a serial phase on the calling thread (every 4096th step of its
+// loop), at the fraction the fill has reached; throws when told to stop. The serial phases (the row table, the flood
+// links, the run groups) take tenths of a second each on a 1024^3 grid: longer than Ctrl-C may wait.
+struct CancelCheck {
+  const FillOptions* options = nullptr;
+  double fraction = 0;
+  void operator()(uint64_t step = 0) const {
+    if (options && options->progress && (step & 4095) == 0 && !options->progress(fraction))
+      fail<Error>("solid fill cancelled");
+  }
+};
+
 // Scratch bytes per listed row and per gap (row table, union-find, flags, solid pieces, the output runs at worst).
 constexpr double kBytesPerRow = 24 + 16 + 16, kBytesPerGap = 16 + 8 + 1 + 8 + 16;
 
-RowTable buildRows(const Grid& grid, uint64_t memoryLimitBytes) {
+RowTable buildRows(const Grid& grid, uint64_t memoryLimitBytes, const CancelCheck& check = {}) {
   const uint64_t nx = grid.dims[0];
   const auto& keys = grid.cellKeys;
   uint64_t rows = 0, gaps = 0;  // counted first so that the budget is checked before allocating
   for (size_t c = 0; c < keys.size(); ++c) {
+    check(c);
     if (c == 0 || keys[c] / nx != keys[c - 1] / nx)
       ++rows;
     else if (keys[c] > keys[c - 1] + 1)
@@ -84,6 +97,7 @@ RowTable buildRows(const Grid& grid, uint64_t memoryLimitBytes) {
   t.gapBegin.reserve(rows + 1);
   t.gaps.reserve(gaps);
   for (size_t c = 0; c < keys.size(); ++c) {
+    check(c);
     if (c == 0 || keys[c] / nx != keys[c - 1] / nx) {
       t.row.push_back(keys[c] / nx);
       t.cellBegin.push_back(c);
@@ -138,7 +152,7 @@ void linkRows(const std::vector<Interval>& a, const std::vector<Interval>& b, Un
 // Face-connected groups of the runs that `keep` accepts, as a union-find over slots. Only listed rows are swept,
 // so runs joined through a row without surface cells stay in separate groups (one more evaluation, never wrong).
 template <typename Keep>
-UnionFind linkRuns(const RowTable& t, const Grid& grid, const Keep& keep) {
+UnionFind linkRuns(const RowTable& t, const Grid& grid, const Keep& keep, const CancelCheck& check) {
   UnionFind uf;
   uf.parent.resize(t.gapBegin.back() + 2 * t.row.size());
   for (uint64_t n = 0; n < uf.parent.size(); ++n) uf.parent[n] = n;
@@ -147,6 +161,7 @@ UnionFind linkRuns(const RowTable& t, const Grid& grid, const Keep& keep) {
   size_t cursor[2] = {0, 0};
   std::vector<Interval> mine, theirs;
   for (size_t r = 0; r < t.row.size(); ++r) {
+    check(r);
     const uint64_t id = t.row[r], j = id % ny, k = id / ny;
     rowIntervals(t, grid, r, mine);
     for (int o = 0; o < 2; ++o) {
@@ -172,7 +187,7 @@ struct PlaneRange {
 // 6-connected components of the empty cells, over runs: a gap is enclosed when its component does not reach
 // the outside. Each pair of listed neighbouring rows is swept once, from the lower row; a neighbour that is not
 // listed (or lies outside the grid) is all empty and outside.
-UnionFind linkGaps(const RowTable& t, const Grid& grid, const PlaneRange& planes = {}) {
+UnionFind linkGaps(const RowTable& t, const Grid& grid, const PlaneRange& planes = {}, const CancelCheck& check = {}) {
   UnionFind uf;
   uf.parent.resize(t.gaps.size() + 1);
   for (uint64_t n = 0; n < uf.parent.size(); ++n) uf.parent[n] = n;
@@ -181,6 +196,7 @@ UnionFind linkGaps(const RowTable& t, const Grid& grid, const PlaneRange& planes
   size_t cursor[4] = {0, 0, 0, 0};  // per offset, first listed row >= target; targets only grow
   std::vector<Interval> mine, theirs;
   for (size_t r = 0; r < t.row.size(); ++r) {
+    check(r);
     const uint64_t id = t.row[r], j = id % ny, k = id / ny;
     const bool hasGaps = t.gapBegin[r + 1] > t.gapBegin[r];
     bool loaded = false;
@@ -429,7 +445,9 @@ std::vector<int64_t> groupIntegers(const Grid& grid, const RowTable& t, const Sc
   std::vector<Root> roots;
   std::vector<Interval> runs;
   const uint64_t nx = grid.dims[0];
+  const CancelCheck check{&sweep.options, 0.5};
   for (size_t r = 0; r < t.row.size(); ++r) {
+    check(r);
     rowIntervals(t, grid, r, runs);
     for (const Interval& run : runs)
       if (sharesK(state[run.slot]) && groups.findConst(run.slot) == run.slot)
@@ -550,7 +568,8 @@ std::pair<uint64_t, uint64_t> decideRuns(const Grid& grid, const FillWinding* wi
     }
   });
   if (!winding || !caps->enabled) return {sweep.full, sweep.caps};
-  const UnionFind groups = linkRuns(t, grid, [&](const Interval& run) { return sharesK(state[run.slot]); });
+  const UnionFind groups =
+      linkRuns(t, grid, [&](const Interval& run) { return sharesK(state[run.slot]); }, CancelCheck{&options, 0.5});
   const std::vector<int64_t> k = groupIntegers(grid, t, *w, *caps, groups, state, sweep);
   // Pass 2: the waiting runs, by k alone, by k - s, or by w itself when k could not be told.
   sweep([&](size_t r, const Interval& run, uint64_t* counts) {
@@ -674,17 +693,21 @@ SlabLinks linkSlab(Grid&& grid, uint32_t k0, uint32_t k1, uint64_t memoryLimitBy
 
 FillReport fillSolid(Grid& grid, const Scene& scene, const FillOptions& options) {
   std::shared_ptr<const FillWinding> winding;
+  const CancelCheck check{&options, 0};
+  check();
   FillReport report = startFill(grid, scene, options, winding);
+  check();
   report.emptyCells = grid.cellCount() - grid.occupiedCount();
-  const RowTable table = buildRows(grid, options.memoryLimitBytes);
+  const RowTable table = buildRows(grid, options.memoryLimitBytes, check);
   std::vector<uint8_t> enclosed;
   {
-    UnionFind uf = linkGaps(table, grid);
+    UnionFind uf = linkGaps(table, grid, {}, check);
+    check();
     const uint64_t outside = uf.find(0);
     enclosed = enclosedGaps(table, uf, [&](uint64_t root) { return root == outside; });
   }
   grid.solidRuns = solidRuns(grid, winding.get(), table, enclosed, 0, options, report);
-  if (options.progress) options.progress(1.0);
+  if (options.progress && !options.progress(1.0)) fail<Error>("solid fill cancelled");
   return report;
 }
 

@@ -18,7 +18,7 @@ int runVoxelFormat(const Options& opt, VoxelFormat format) {
   // binvox and .vox need only the voxels in key order (with each occupied cell's colour for .vox): a set is then
   // read one layer of bricks at a time on each of the writer's passes instead of assembled, which keeps the peak
   // memory to a layer (docs/scaling.md). .vdb builds OpenVDB's tree of the whole grid, so its set is assembled.
-  const bool layered = format != VoxelFormat::Vdb && isGridSet(opt.grid);
+  const bool layered = format != VoxelFormat::Vdb && format != VoxelFormat::Npz && isGridSet(opt.grid);
   GridSetManifest set;
   GridFile file;
   if (layered) {

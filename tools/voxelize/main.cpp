@@ -1,6 +1,7 @@
 // vox-voxelize: scene file -> grid file (or, with --bricks, a grid set: run_set.cpp).
 #include <chrono>
 
+#include "distances.h"
 #include "options.h"
 #include "report.h"
 #include "run_set.h"
@@ -44,6 +45,7 @@ Grid voxelizeAndFill(const Options& opt, const Scene& scene, VoxelizeOptions vo,
       fillBar.finish();
       voxelize_tool::reportFill(opt, report);
     }
+    voxelize_tool::addDistances(opt, scene, vo.memoryLimitBytes, grid);
     return grid;
   } catch (const LimitError& e) {
     fail<LimitError>(opt.scene, ": ", e.what());
@@ -55,10 +57,11 @@ Grid voxelizeAndFill(const Options& opt, const Scene& scene, VoxelizeOptions vo,
 int run(const Options& opt) {
   const auto start = std::chrono::steady_clock::now();
   auto threads = cli::limitThreads(opt.common.threads);
-  const VoxelizeOptions vo = voxelize_tool::voxelizeOptions(opt);
+  VoxelizeOptions vo = voxelize_tool::voxelizeOptions(opt);
 
   // Before the scene is read: `-o scene.glb` would destroy the scene.
   checkOutputPath(opt.output, {opt.scene});
+  voxelize_tool::checkDistanceFlags(opt);
   if (!opt.bricks.empty()) checkGridSetOutput(opt.output);  // "-o foo.bricks": refused before any work
   const std::optional<GridSetManifest> previousSet = opt.bricks.empty() ? previousGridSet(opt.output) : std::nullopt;
   const Scene scene = loadScene(opt.scene);
@@ -68,6 +71,7 @@ int run(const Options& opt) {
     for (const auto& w : scene.warnings) std::fputs(warningLine("vox-voxelize", w).c_str(), stderr);
   if (!opt.bricks.empty()) return voxelize_tool::runSet(opt, scene, vo, start);
   VoxelizeStats stats;
+  vo = voxelize_tool::cubicCellsForDistances(opt, scene, vo);
   const Grid grid = voxelizeAndFill(opt, scene, vo, stats);
   if (!grid.outsidePrims.empty() && !opt.common.quiet)
     std::fputs(warningLine("vox-voxelize", opt.scene + ": " + std::to_string(grid.outsidePrims.size()) +

@@ -21,6 +21,22 @@ void addOptions(CLI::App& app, Options& opt) {
   app.add_flag("--fill", opt.fill,
                "Also mark the empty cells inside the surfaces as solid: flood fill for closed meshes, |winding "
                "number| >= 0.5 for open ones; says which on stderr");
+  app.add_option_function<std::vector<std::string>>(
+         "--sdf",
+         [&opt](const std::vector<std::string>& half) {
+           // Given bare, CLI11 hands over no value or an empty one: the default band.
+           if (half.empty() || half[0].empty()) return void(opt.sdf = 3.0);
+           double value = 0;
+           if (!CLI::detail::lexical_cast(half[0], value)) throw CLI::ValidationError("--sdf", "HALF " + half[0] + " is not a number");
+           opt.sdf = value;
+         },
+         "Also store the signed distance (world units, negative inside as --fill decides) at the centre of every "
+         "cell within HALF cell widths of the surface (default 3); planes are left out")
+      ->expected(0, 1)
+      ->type_name("[HALF]");
+  app.add_flag("--fraction", opt.fraction,
+               "Also store each occupied cell's volume fraction inside the solid: exact for closed meshes and "
+               "spheres; open meshes and ellipsoids are refused");
   app.add_option("--bricks", opt.bricks,
                  "Write a grid set: OUT is a manifest naming the scene file and one brick file per non-empty brick "
                  "of BX x BY x BZ bricks (in a new folder OUT_NAME.bricks/gHEX/ beside it; the old set is removed once "

@@ -65,68 +65,143 @@ double smallestCellEdge(const Grid& grid) {
   return h;
 }
 
-// Emits the cells of box [lo - reach, hi + reach] whose centre lies within `reach` of a primitive, as told by
-// `squaredDistance(centre)` (negative: rejected early).
-template <typename SquaredDistance>
-void emitCells(const Grid& grid, const Centres& centres, const Vec3& lo, const Vec3& hi, double reach,
-               const SquaredDistance& squaredDistance, std::vector<Candidate>& out) {
-  std::array<std::array<int64_t, 2>, 3> range;
-  for (int a = 0; a < 3; ++a) {
-    range[a] = cellRange(grid.bounds, grid.dims, a, lo[a] - reach, hi[a] + reach);
-    if (range[a][0] > range[a][1]) return;
-  }
-  const double reach2 = reach * reach;
-  for (int64_t k = range[2][0]; k <= range[2][1]; ++k)
-    for (int64_t j = range[1][0]; j <= range[1][1]; ++j)
-      for (int64_t i = range[0][0]; i <= range[0][1]; ++i) {
-        const Vec3 c{centres.axis[0][i], centres.axis[1][j], centres.axis[2][k]};
-        const double d2 = squaredDistance(c);
-        if (d2 >= 0 && d2 <= reach2) out.push_back({cellKey(grid.dims, i, j, k), d2});
-      }
-}
+// Cells are processed in tiles of kTile^3: each primitive is binned into the tiles its box grown by the band's
+// reach meets, and each tile keeps the nearest squared distance of its cells in a small dense array. Memory is then
+// the band's cells and the bins, not one entry per (cell, primitive) pair (which took 0.5 GB for the bunny at 256^3).
+constexpr uint32_t kTile = 16;
 
-// Every (cell, squared distance) pair of the band, one per primitive near the cell, in no particular order.
+struct Reachable {
+  std::array<std::array<int64_t, 2>, 3> cells;  // inclusive cell ranges of the primitive's box grown by the reach
+  bool empty() const { return cells[0][0] > cells[0][1] || cells[1][0] > cells[1][1] || cells[2][0] > cells[2][1]; }
+};
+
+// The squared distance from c to primitive p (triangles first, then the spheres' shapes), or -1 when the triangle's
+// plane alone is farther than sqrt(bound2): most cells of a triangle's box, and cells a nearer triangle already took.
+struct PrimitiveDistance {
+  const Scene& scene;
+  const std::vector<EllipsoidShape>& shapes;
+  const std::vector<Vec3>& normals;  // triangles' (b - a) x (c - a)
+
+  double operator()(size_t p, const Vec3& c, double bound2) const {
+    if (p < scene.triangles.size()) {
+      const Triangle& t = scene.triangles[p];
+      const double plane = dot(normals[p], c - t.v[0]);
+      if (plane * plane > bound2 * dot(normals[p], normals[p])) return -1;
+      return squaredDistanceToTriangle(t.v[0], t.v[1], t.v[2], c);
+    }
+    const EllipsoidShape& s = shapes[p - scene.triangles.size()];
+    const Vec3 d = c - closestPointOnEllipsoid(s, c);
+    return dot(d, d);
+  }
+  Box box(size_t p) const {
+    if (p < scene.triangles.size()) {
+      const Triangle& t = scene.triangles[p];
+      return {minVec(minVec(t.v[0], t.v[1]), t.v[2]), maxVec(maxVec(t.v[0], t.v[1]), t.v[2])};
+    }
+    const EllipsoidShape& s = shapes[p - scene.triangles.size()];
+    const double big = s.semi.x;  // semi-axes descending
+    return {s.center - Vec3{big, big, big}, s.center + Vec3{big, big, big}};
+  }
+};
+
+struct TilePrim {
+  uint64_t tile;
+  uint32_t prim;
+  bool operator<(const TilePrim& o) const { return tile != o.tile ? tile < o.tile : prim < o.prim; }
+};
+
+// The band's cells with their nearest squared distance, in no particular order.
 std::vector<Candidate> bandCandidates(const Grid& grid, const Scene& scene, double reach, const SdfOptions& options) {
   const Centres centres(grid);
   std::vector<EllipsoidShape> shapes;
   for (const Sphere& s : scene.spheres) shapes.push_back(ellipsoidShape(s));
-  const size_t triangles = scene.triangles.size(), prims = triangles + shapes.size();
+  std::vector<Vec3> normals(scene.triangles.size());
+  for (size_t t = 0; t < normals.size(); ++t) {
+    const Triangle& tr = scene.triangles[t];
+    normals[t] = cross(tr.v[1] - tr.v[0], tr.v[2] - tr.v[0]);
+  }
+  const PrimitiveDistance distance{scene, shapes, normals};
+  const size_t prims = scene.triangles.size() + shapes.size();
+  std::array<uint64_t, 3> tiles;
+  for (int a = 0; a < 3; ++a) tiles[a] = (grid.dims[a] + kTile - 1) / kTile;
+  const auto reachable = [&](size_t p) {
+    const Box b = distance.box(p);
+    Reachable r;
+    for (int a = 0; a < 3; ++a) r.cells[a] = cellRange(grid.bounds, grid.dims, a, b.lo[a] - reach, b.hi[a] + reach);
+    return r;
+  };
+  // Bins.
+  tbb::enumerable_thread_specific<std::vector<TilePrim>> binLocals;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, prims, 1024), [&](const tbb::blocked_range<size_t>& r) {
+    std::vector<TilePrim>& out = binLocals.local();
+    for (size_t p = r.begin(); p < r.end(); ++p) {
+      const Reachable c = reachable(p);
+      if (c.empty()) continue;
+      for (int64_t tz = c.cells[2][0] / kTile; tz <= c.cells[2][1] / kTile; ++tz)
+        for (int64_t ty = c.cells[1][0] / kTile; ty <= c.cells[1][1] / kTile; ++ty)
+          for (int64_t tx = c.cells[0][0] / kTile; tx <= c.cells[0][1] / kTile; ++tx)
+            out.push_back({uint64_t(tx) + tiles[0] * (uint64_t(ty) + tiles[1] * uint64_t(tz)), uint32_t(p)});
+    }
+  });
+  std::vector<TilePrim> bins;
+  for (auto& local : binLocals) bins.insert(bins.end(), local.begin(), local.end());
+  if (bins.size() * sizeof(TilePrim) > options.memoryLimitBytes)
+    fail<LimitError>("signed distance band: ", bins.size(), " primitive bins exceed the memory limit of ",
+                     options.memoryLimitBytes >> 20, " MiB; use a narrower band or fewer cells");
+  tbb::parallel_sort(bins.begin(), bins.end());
+  std::vector<size_t> starts;  // each tile's first bin
+  for (size_t b = 0; b < bins.size(); ++b)
+    if (b == 0 || bins[b].tile != bins[b - 1].tile) starts.push_back(b);
+  starts.push_back(bins.size());
+  // Tiles.
   tbb::enumerable_thread_specific<std::vector<Candidate>> locals;
   std::atomic<uint64_t> done{0}, emitted{0};
   std::atomic<bool> cancelled{false}, overBudget{false};
-  const uint64_t maxCandidates = options.memoryLimitBytes / (2 * sizeof(Candidate));  // the pairs, then the merge
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, prims, 64), [&](const tbb::blocked_range<size_t>& r) {
+  const uint64_t maxCells = options.memoryLimitBytes / (2 * sizeof(Candidate));
+  const double reach2 = reach * reach;
+  const size_t tileCount = starts.size() - 1;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, tileCount, 4), [&](const tbb::blocked_range<size_t>& r) {
     if (cancelled || overBudget) return;
     std::vector<Candidate>& out = locals.local();
     const size_t before = out.size();
-    for (size_t p = r.begin(); p < r.end(); ++p) {
-      if (p < triangles) {
-        const Triangle& t = scene.triangles[p];
-        const Vec3 n = cross(t.v[1] - t.v[0], t.v[2] - t.v[0]);
-        const double planeReach = reach * length(n);  // |n . (c - a)| > reach |n|: the plane alone is too far
-        emitCells(grid, centres, minVec(minVec(t.v[0], t.v[1]), t.v[2]), maxVec(maxVec(t.v[0], t.v[1]), t.v[2]),
-                  reach, [&](const Vec3& c) {
-                    if (std::fabs(dot(n, c - t.v[0])) > planeReach) return -1.0;
-                    return squaredDistanceToTriangle(t.v[0], t.v[1], t.v[2], c);
-                  }, out);
-      } else {
-        const EllipsoidShape& s = shapes[p - triangles];
-        const double big = s.semi.x;  // semi-axes descending
-        emitCells(grid, centres, s.center - Vec3{big, big, big}, s.center + Vec3{big, big, big}, reach,
-                  [&](const Vec3& c) {
-                    const Vec3 d = c - closestPointOnEllipsoid(s, c);
-                    return dot(d, d);
-                  }, out);
+    std::vector<double> nearest(size_t(kTile) * kTile * kTile);
+    for (size_t g = r.begin(); g < r.end(); ++g) {
+      const uint64_t tile = bins[starts[g]].tile;
+      const int64_t t0[3] = {int64_t(tile % tiles[0]) * kTile, int64_t(tile / tiles[0] % tiles[1]) * kTile,
+                             int64_t(tile / (tiles[0] * tiles[1])) * kTile};
+      std::fill(nearest.begin(), nearest.end(), INFINITY);
+      for (size_t b = starts[g]; b < starts[g + 1]; ++b) {
+        const size_t p = bins[b].prim;
+        const Reachable c = reachable(p);
+        int64_t lo[3], hi[3];
+        for (int a = 0; a < 3; ++a) {
+          lo[a] = std::max(c.cells[a][0], t0[a]);
+          hi[a] = std::min({c.cells[a][1], t0[a] + int64_t(kTile) - 1, int64_t(grid.dims[a]) - 1});
+        }
+        for (int64_t k = lo[2]; k <= hi[2]; ++k)
+          for (int64_t j = lo[1]; j <= hi[1]; ++j)
+            for (int64_t i = lo[0]; i <= hi[0]; ++i) {
+              double& slot = nearest[size_t(i - t0[0]) + kTile * (size_t(j - t0[1]) + kTile * size_t(k - t0[2]))];
+              const double d2 =
+                  distance(p, {centres.axis[0][i], centres.axis[1][j], centres.axis[2][k]}, std::min(slot, reach2));
+              if (d2 >= 0 && d2 < slot) slot = d2;
+            }
       }
+      for (uint32_t k = 0; k < kTile; ++k)
+        for (uint32_t j = 0; j < kTile; ++j)
+          for (uint32_t i = 0; i < kTile; ++i) {
+            const double d2 = nearest[i + kTile * (j + kTile * k)];
+            if (d2 <= reach2) out.push_back({cellKey(grid.dims, t0[0] + i, t0[1] + j, t0[2] + k), d2});
+          }
     }
-    if ((emitted += out.size() - before) > maxCandidates) overBudget = true;
+    if ((emitted += out.size() - before) > maxCells) overBudget = true;
     const uint64_t finished = done += r.size();
-    if (options.progress && !options.progress(0.8 * double(finished) / double(prims))) cancelled = true;
+    if (options.progress && !options.progress(0.8 * double(finished) / double(tileCount))) cancelled = true;
   });
   if (cancelled) fail<Error>("signed distances cancelled");
   if (overBudget)
-    fail<LimitError>("signed distance band: more than ", maxCandidates, " cell-primitive distances within ",
-                     options.halfWidth, " cell widths, over the memory limit of ", options.memoryLimitBytes >> 20,
+    fail<LimitError>("signed distance band: more than ", maxCells, " cells within ", options.halfWidth,
+                     " cell widths, over the memory limit of ", options.memoryLimitBytes >> 20,
                      " MiB; use a narrower band or fewer cells");
   std::vector<Candidate> all;
   all.reserve(emitted);
@@ -140,7 +215,7 @@ SdfBand signedDistanceBand(const Grid& grid, const Scene& scene, const SdfOption
   checkSdfHalfWidth(options.halfWidth, "--sdf");
   const double reach = options.halfWidth * smallestCellEdge(grid);
   std::vector<Candidate> all = bandCandidates(grid, scene, reach, options);
-  tbb::parallel_sort(all.begin(), all.end());  // by key, then distance: each key's first entry is its nearest
+  tbb::parallel_sort(all.begin(), all.end());  // by key (each key once)
   SdfBand band;
   for (size_t i = 0; i < all.size(); ++i)
     if (i == 0 || all[i].key != all[i - 1].key) {

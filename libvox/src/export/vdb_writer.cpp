@@ -8,6 +8,7 @@
 #include <openvdb/math/Maps.h>
 #include <openvdb/math/Transform.h>
 #include <openvdb/openvdb.h>
+#include <openvdb/tools/SignedFloodFill.h>
 
 #include <algorithm>
 #include <array>
@@ -372,6 +373,34 @@ openvdb::FloatGrid::Ptr buildCount(const Grid& grid) {
   return count;
 }
 
+// The --sdf band as an OpenVDB level set: `surface`, class level set, background HALF x voxel size, the band's
+// cells active with their distance (rounded to float, within the background), the rest inactive and signed by
+// OpenVDB's own flood fill. A level set needs cubic voxels: other cells are refused.
+openvdb::FloatGrid::Ptr buildLevelSet(const Grid& grid, const openvdb::math::Transform::Ptr& transform) {
+  double lo = INFINITY, hi = 0;
+  double size[3];
+  for (int a = 0; a < 3; ++a) {
+    size[a] = (grid.bounds.hi[a] - grid.bounds.lo[a]) / grid.dims[a];
+    lo = std::min(lo, size[a]), hi = std::max(hi, size[a]);
+  }
+  if (hi > lo * (1 + 1e-9))
+    fail<UsageError>("a level set needs cubic cells; this grid's are ", size[0], " x ", size[1], " x ", size[2],
+                     " (voxelize with --res, which keeps cells cubic, or export .npz)");
+  const float background = float(grid.sdfHalfWidth * lo);
+  auto surface = openvdb::FloatGrid::create(background);
+  auto acc = surface->getAccessor();
+  for (size_t b = 0; b < grid.sdfKeys.size(); ++b) {
+    const auto ijk = cellIndex(grid.dims, grid.sdfKeys[b]);
+    const float d = std::clamp(float(grid.sdfValues[b]), -background, background);
+    acc.setValueOn(openvdb::Coord(int(ijk[0]), int(ijk[1]), int(ijk[2])), d);
+  }
+  openvdb::tools::signedFloodFill(surface->tree());
+  surface->setName("surface");
+  surface->setGridClass(openvdb::GRID_LEVEL_SET);
+  surface->setTransform(transform->copy());
+  return surface;
+}
+
 }  // namespace
 
 VdbStats writeVdb(std::ostream& out, const Grid& grid, const std::function<void(double)>& progress) {
@@ -392,7 +421,15 @@ VdbStats writeVdb(std::ostream& out, const Grid& grid, const std::function<void(
   count->setName("count");
   count->setTransform(transform->copy());
 
+  if (!grid.fractions.empty()) {  // the density holds how much of each occupied cell is inside (solid cells: 1)
+    auto acc = density->getAccessor();
+    for (size_t c = 0; c < grid.cellKeys.size(); ++c) {
+      const auto ijk = cellIndex(grid.dims, grid.cellKeys[c]);
+      acc.setValueOn(openvdb::Coord(int(ijk[0]), int(ijk[1]), int(ijk[2])), float(grid.fractions[c]));
+    }
+  }
   openvdb::GridPtrVec grids{density, count};
+  if (grid.sdfHalfWidth > 0) grids.push_back(buildLevelSet(grid, transform));
   openvdb::io::Stream(out).write(grids);
   return {density->activeVoxelCount(), density->tree().leafCount()};
 }

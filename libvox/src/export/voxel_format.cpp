@@ -2,12 +2,15 @@
 // a grid set's layers of bricks.
 #include "vox/export/voxel_format.h"
 
+#include "vox/export/npz_writer.h"
+
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
 
 #include "vox/export/binvox_writer.h"
 #include "vox/export/magicavoxel_writer.h"
+#include "vox/export/npz_writer.h"
 #include "vox/export/vdb_writer.h"
 #include "vox/export/voxel_runs.h"
 #include "vox/core/error.h"
@@ -69,6 +72,7 @@ std::optional<VoxelFormat> voxelFormatFromPath(const std::string& path) {
   if (ext == ".binvox") return VoxelFormat::Binvox;
   if (ext == ".vox") return VoxelFormat::MagicaVoxel;
   if (ext == ".vdb") return VoxelFormat::Vdb;
+  if (ext == ".npz") return VoxelFormat::Npz;
   return std::nullopt;
 }
 
@@ -89,6 +93,10 @@ VoxelFileReport writeVoxelFile(const std::string& path, VoxelFormat format, cons
       report.models = s.leafNodes;
       break;
     }
+    case VoxelFormat::Npz:
+      writeNpz(file.stream(), grid, progress);
+      report.voxels = grid.occupiedCount() + grid.solidCount();
+      break;
   }
   file.commit();
   return report;
@@ -97,7 +105,7 @@ VoxelFileReport writeVoxelFile(const std::string& path, VoxelFormat format, cons
 VoxelFileReport writeGridSetVoxelFile(const std::string& path, VoxelFormat format, const std::string& setPath,
                                       const GridSetManifest& set, const GridFile& sceneFile, ColorMode color,
                                       const std::function<void(double)>& progress) {
-  VOX_CHECK(format != VoxelFormat::Vdb);
+  VOX_CHECK(format != VoxelFormat::Vdb && format != VoxelFormat::Npz);
   const Grid& plan = sceneFile.grid;
   VoxelFileReport report;
   OutputFile file(path);

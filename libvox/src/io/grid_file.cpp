@@ -419,7 +419,7 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
     grid.solidRuns = r.getArray<CellRun>("solid run");
     checkSolidRuns(grid.solidRuns, cells, name + ": solid runs at byte " + std::to_string(runsAt));
     getSections(r, scene, grid);
-    if (version < gridFileVersionFor(grid))
+    if (version < 4 && gridFileVersionFor(grid) == 4)
       fail<InputError>(name, ": distances or volume fractions in a version ", version, " file (they need version 4)");
   }
   if (version < 3) checkFlatCellTable(grid, bounded, name, cellsAt);

@@ -1,6 +1,7 @@
 #include "vox/io/info.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <functional>
@@ -87,6 +88,65 @@ Summary summarize(const InfoSource& in) {
   return s;
 }
 
+// The solid's volume as the scene gives it: the triangles' signed volume (divergence theorem: sum of a . (b x c) / 6,
+// positive for outward-oriented closed meshes) plus each sphere's and ellipsoid's 4/3 pi r^3 |det L|.
+double sceneVolume(const Scene& sc) {
+  double v = 0;
+  for (const Triangle& t : sc.triangles) v += dot(t.v[0], cross(t.v[1], t.v[2])) / 6;
+  for (const Sphere& sp : sc.spheres) {
+    const auto& m = sp.transform.m;
+    const double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+                       m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    v += 4.0 / 3.0 * M_PI * sp.radius * sp.radius * sp.radius * std::fabs(det);
+  }
+  return v;
+}
+
+// What --sdf and --fraction stored: the band's size and range; the fractions' volume beside the scene's own.
+struct DistanceSummary {
+  double bandMin = 0, bandMax = 0;
+  double fractionVolume = 0, sceneVolume = 0;
+};
+
+DistanceSummary summarizeDistances(const Scene& sc, const Grid& g, uint64_t solidCells) {
+  DistanceSummary d;
+  if (!g.sdfValues.empty()) {
+    d.bandMin = *std::min_element(g.sdfValues.begin(), g.sdfValues.end());
+    d.bandMax = *std::max_element(g.sdfValues.begin(), g.sdfValues.end());
+  }
+  if (!g.fractions.empty()) {
+    double cell = 1;
+    for (int a = 0; a < 3; ++a) cell *= (g.bounds.hi[a] - g.bounds.lo[a]) / g.dims[a];
+    double sum = double(solidCells);
+    for (double f : g.fractions) sum += f;
+    d.fractionVolume = sum * cell;
+    d.sceneVolume = sceneVolume(sc);
+  }
+  return d;
+}
+
+void plainDistances(std::ostream& out, const InfoSource& in) {
+  const Grid& g = in.plan;
+  const DistanceSummary d = summarizeDistances(in.scene, g, in.totals.solidCells);
+  if (g.sdfHalfWidth > 0)
+    out << "distance_band: " << g.sdfKeys.size() << " cells within " << num(g.sdfHalfWidth)
+        << " cell widths, signed distances " << num(d.bandMin) << " to " << num(d.bandMax) << "\n";
+  if (!g.fractions.empty())
+    out << "fraction_volume: " << num(d.fractionVolume) << " (the scene's own volume: " << num(d.sceneVolume)
+        << ")\n";
+}
+
+void jsonDistances(std::ostream& out, const InfoSource& in) {
+  const Grid& g = in.plan;
+  const DistanceSummary d = summarizeDistances(in.scene, g, in.totals.solidCells);
+  if (g.sdfHalfWidth > 0)
+    out << "  \"distance_band\": {\"cells\": " << g.sdfKeys.size() << ", \"half_width\": " << num(g.sdfHalfWidth)
+        << ", \"min\": " << num(d.bandMin) << ", \"max\": " << num(d.bandMax) << "},\n";
+  if (!g.fractions.empty())
+    out << "  \"fractions\": {\"volume\": " << num(d.fractionVolume) << ", \"scene_volume\": " << num(d.sceneVolume)
+        << "},\n";
+}
+
 void plain(std::ostream& out, const InfoSource& in) {
   const Grid& g = in.plan;
   const Scene& sc = in.scene;
@@ -118,6 +178,7 @@ void plain(std::ostream& out, const InfoSource& in) {
   out << "references: " << t.references << "\n";
   out << "outside_primitives: " << g.outsidePrims.size() << "\n";
   out << "memory_bytes: " << s.memoryBytes << "\n";
+  plainDistances(out, in);
   out << "primitives per occupied cell:\n";
   size_t maxCells = 1;
   for (const auto& [k, n] : t.histogram) maxCells = std::max(maxCells, n);
@@ -146,6 +207,7 @@ void jsonHead(std::ostream& out, const InfoSource& in) {
   out << "  \"references\": " << t.references << ",\n";
   out << "  \"outside_primitives\": " << g.outsidePrims.size() << ",\n";
   out << "  \"memory_bytes\": " << s.memoryBytes << ",\n";
+  jsonDistances(out, in);
   // Solid textures by the material that uses them (the course's Checkerboard, Noise, Marble, Wood).
   out << "  \"solid_textures\": [";
   for (size_t m = 0, n = 0; m < sc.materials.size(); ++m) {

@@ -20,7 +20,10 @@ struct VdbStats {
 //    elsewhere; uniform blocks are stored as tiles, so a filled interior costs little;
 //  - `count` (FloatGrid, a float so that pyopenvdb reads the file): the number of primitives held by each occupied
 //    cell (solid-only cells are not in it).
-// Both carry the grid's exact per-axis voxel transform (a ScaleTranslateMap): index (i, j, k) is the centre of cell
+// With volume fractions (--fraction), `density` holds each occupied cell's fraction instead of 1. With distances
+// (--sdf), a third grid `surface`: an OpenVDB level set (class level set, background HALF x voxel size, the band's
+// signed distances as floats, inactive voxels signed by OpenVDB's flood fill); it needs cubic cells (UsageError).
+// All carry the grid's exact per-axis voxel transform (a ScaleTranslateMap): index (i, j, k) is the centre of cell
 // (i, j, k), world = lo + (index + 0.5) * (hi - lo) / n on each axis, so non-cubic cells keep their shape.
 // Memory grows with the occupied cells and the solid runs' surface, not with the solid volume: the solid interior
 // is built 8 layers of z at a time and pruned into tiles before the next layer.

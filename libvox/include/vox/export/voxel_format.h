@@ -15,9 +15,9 @@
 
 namespace vox {
 
-enum class VoxelFormat : uint8_t { Binvox, MagicaVoxel, Vdb };
+enum class VoxelFormat : uint8_t { Binvox, MagicaVoxel, Vdb, Npz };
 
-// The voxel format of `path`'s extension (.binvox, .vox, .vdb; case-insensitive), or nullopt for any other.
+// The voxel format of `path`'s extension (.binvox, .vox, .vdb, .npz; case-insensitive), or nullopt for any other.
 std::optional<VoxelFormat> voxelFormatFromPath(const std::string& path);
 
 // What was written, for the tool's --stats and warnings.

@@ -1,7 +1,7 @@
 # Type stub of the libvox package (the compiled module libvox._libvox, re-exported). Kept in step with the binding by
 # tests/python/test_stub.py, which compares every name, parameter and default here with the module's.
 import os
-from typing import Any, Callable, Iterable, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Iterable, Optional, Sequence, SupportsIndex, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -12,6 +12,10 @@ _Path = Union[str, bytes, os.PathLike]
 _Array = npt.ArrayLike
 _Source = Union[_Path, Tuple[_Array, _Array], Any]
 _Progress = Union[bool, None, Callable[[float], None]]
+# What the conversion layer takes (python/src/convert.h): an integer is anything with __index__ (numpy's too), a
+# number any real number (numbers.Real); a bool is neither.
+_Int = SupportsIndex
+_Float = Union[float, int, np.floating, np.integer]
 
 class InputError(ValueError): ...
 class UsageError(ValueError): ...
@@ -55,12 +59,12 @@ class Grid:
         faces: str = "exposed",
         color: str = "count",
         ascii: bool = False,
-        bricks: Union[None, int, Sequence[int]] = None,
-        threads: Optional[int] = None,
+        bricks: Union[None, _Int, Sequence[_Int]] = None,
+        threads: Optional[_Int] = None,
         progress: _Progress = False,
     ) -> None: ...
     def mesh(
-        self, faces: str = "merged", color: str = "none", *, threads: Optional[int] = None
+        self, faces: str = "merged", color: str = "none", *, threads: Optional[_Int] = None
     ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int32], Optional[npt.NDArray[np.uint8]]]: ...
     def colors(self, mode: str = "material") -> npt.NDArray[np.uint8]: ...
     def intersect(
@@ -68,7 +72,7 @@ class Grid:
         origins: _Array,
         directions: _Array,
         tmax: Union[float, _Array] = ...,
-        threads: Optional[int] = None,
+        threads: Optional[_Int] = None,
         *,
         accel: str = "grid",
     ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64], npt.NDArray[np.float64]]: ...
@@ -77,7 +81,7 @@ class Grid:
         origins: _Array,
         directions: _Array,
         tmax: Union[float, _Array] = ...,
-        threads: Optional[int] = None,
+        threads: Optional[_Int] = None,
         *,
         accel: str = "grid",
     ) -> npt.NDArray[np.bool_]: ...
@@ -86,42 +90,42 @@ def load(path: _Path) -> Grid: ...
 def voxelize(
     source: _Source,
     *,
-    resolution: Optional[int] = None,
-    dims: Union[None, int, Sequence[int]] = None,
-    pitch: Union[None, float, Sequence[float]] = None,
+    resolution: Optional[_Int] = None,
+    dims: Union[None, _Int, Sequence[_Int]] = None,
+    pitch: Union[None, _Float, Sequence[_Float]] = None,
     bounds: Optional[_Array] = None,
     method: str = "exact",
     fill: Optional[bool] = None,
-    threads: Optional[int] = None,
+    threads: Optional[_Int] = None,
     progress: _Progress = False,
 ) -> Grid: ...
 def voxelize_batch(
     sources: Iterable[_Source],
-    resolution: int = 64,
+    resolution: _Int = 64,
     *,
     fill: Optional[bool] = None,
     method: str = "exact",
-    threads: Optional[int] = None,
+    threads: Optional[_Int] = None,
     dense: bool = True,
     progress: _Progress = False,
 ) -> Union[npt.NDArray[np.bool_], list[Grid]]: ...
 def render(
     grid: Grid,
-    size: Tuple[int, int] = (512, 512),
+    size: Sequence[_Int] = (512, 512),
     mode: str = "shade",
     *,
-    samples: int = 1,
-    bounces: int = 0,
-    weight: float = 0.01,
+    samples: _Int = 1,
+    bounces: _Int = 0,
+    weight: _Float = 0.01,
     shade_back: bool = False,
     shadows: bool = True,
-    filter: Optional[Tuple[str, float]] = None,
+    filter: Optional[Tuple[str, _Float]] = None,
     eye: Optional[_Array] = None,
     look_at: Optional[_Array] = None,
     up: Optional[_Array] = None,
-    fov: Optional[float] = None,
+    fov: Optional[_Float] = None,
     accel: str = "grid",
-    threads: Optional[int] = None,
+    threads: Optional[_Int] = None,
     progress: _Progress = False,
 ) -> npt.NDArray[np.float32]: ...
 def save_image(path: _Path, image: _Array) -> None: ...

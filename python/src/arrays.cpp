@@ -77,8 +77,8 @@ py::array asArray(const py::handle& obj, const char* name) {
     return py::module_::import("numpy").attr("asarray")(obj);
   } catch (py::error_already_set& e) {
     if (!e.matches(PyExc_ValueError)) throw;
-    vox::fail<vox::InputError>(name, ": not an array: rows of different lengths? (numpy: ",
-                               std::string(py::str(e.value())), ")");
+    vox::fail<vox::InputError>(
+        name, ": not an array: rows of different lengths? (numpy: ", std::string(py::str(e.value())), ")");
   }
 }
 

@@ -64,13 +64,9 @@ std::string pathArg(const py::handle& obj, const std::string& name) {
   return path;
 }
 
-py::str pathText(const std::string& path) {
-  return py::module_::import("os").attr("fsdecode")(py::bytes(path));
-}
+py::str pathText(const std::string& path) { return py::module_::import("os").attr("fsdecode")(py::bytes(path)); }
 
-bool isBool(const py::handle& obj) {
-  return py::isinstance<py::bool_>(obj) || py::isinstance(obj, types().numpyBool);
-}
+bool isBool(const py::handle& obj) { return py::isinstance<py::bool_>(obj) || py::isinstance(obj, types().numpyBool); }
 
 int64_t intArg(const py::handle& obj, const std::string& name, int64_t lo, int64_t hi) {
   if (isBool(obj)) failType(name, " must be an int, not bool");
@@ -89,8 +85,7 @@ int64_t intArg(const py::handle& obj, const std::string& name, int64_t lo, int64
 }
 
 double floatArg(const py::handle& obj, const std::string& name, bool allowInfinite) {
-  if (isBool(obj) || !py::isinstance(obj, types().real))
-    failType(name, " must be a number, not ", typeName(obj));
+  if (isBool(obj) || !py::isinstance(obj, types().real)) failType(name, " must be a number, not ", typeName(obj));
   double d;
   if (PyObject* index = PyNumber_Index(obj.ptr())) {
     // An integer: exact only when the double holds it (every one up to 2^53); nothing is rounded silently.
@@ -121,7 +116,8 @@ bool boolArg(const py::handle& obj, const std::string& name, bool allowNone) {
 std::string strArg(const py::handle& obj, const std::string& name) {
   if (!py::isinstance<py::str>(obj)) failType(name, " must be a str, not ", typeName(obj));
   // Encoded with surrogateescape so that a lone surrogate cannot raise UnicodeEncodeError; the parser refuses it.
-  const py::bytes b = py::reinterpret_steal<py::bytes>(PyUnicode_AsEncodedString(obj.ptr(), "utf-8", "surrogateescape"));
+  const py::bytes b =
+      py::reinterpret_steal<py::bytes>(PyUnicode_AsEncodedString(obj.ptr(), "utf-8", "surrogateescape"));
   if (!b) throw py::error_already_set();
   return std::string(b);
 }

@@ -58,7 +58,8 @@ vox::Camera resolveCamera(const PyGrid& g, const py::object& eye, const py::obje
     if (cam.up.x == 0 && cam.up.y == 0 && cam.up.z == 0) fail<UsageError>("up must not be zero");
     cam.up = measurable(cam.up);
     if (!(length(cross(normalize(measurable(cam.direction)), cam.up)) > 0))
-      fail<UsageError>("up is parallel to the view direction", eye.is_none() ? " (the scene camera's)" : " (eye to look_at)");
+      fail<UsageError>("up is parallel to the view direction",
+                       eye.is_none() ? " (the scene camera's)" : " (eye to look_at)");
   }
   if (!fov.is_none()) {
     const double f = floatArg(fov, "fov");
@@ -152,7 +153,8 @@ void saveImage(const py::object& pathObj, const py::handle& pixels) {
   if (a.shape(0) > kMaxSide || a.shape(1) > kMaxSide)
     vox::fail<vox::InputError>("image: at most ", kMaxSide, " pixels a side, got shape ", shapeText(a));
   if (!vox::imageFormatSupported(path))
-    vox::fail<vox::UsageError>("path: ", path, ": unknown image format (use an extension such as .png, .tga, .exr, .jpg)");
+    vox::fail<vox::UsageError>("path: ", path,
+                               ": unknown image format (use an extension such as .png, .tga, .exr, .jpg)");
   vox::Image image;
   image.height = uint32_t(a.shape(0));
   image.width = uint32_t(a.shape(1));

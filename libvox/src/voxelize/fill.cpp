@@ -568,8 +568,8 @@ std::pair<uint64_t, uint64_t> decideRuns(const Grid& grid, const FillWinding* wi
     }
   });
   if (!winding || !caps->enabled) return {sweep.full, sweep.caps};
-  const UnionFind groups =
-      linkRuns(t, grid, [&](const Interval& run) { return sharesK(state[run.slot]); }, CancelCheck{&options, 0.5});
+  const UnionFind groups = linkRuns(
+      t, grid, [&](const Interval& run) { return sharesK(state[run.slot]); }, CancelCheck{&options, 0.5});
   const std::vector<int64_t> k = groupIntegers(grid, t, *w, *caps, groups, state, sweep);
   // Pass 2: the waiting runs, by k alone, by k - s, or by w itself when k could not be told.
   sweep([&](size_t r, const Interval& run, uint64_t* counts) {

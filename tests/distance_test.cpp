@@ -133,11 +133,12 @@ TEST(DistanceEllipsoid, ClosestPointsLieOnTheSurfaceAlongTheNormalAndBeatEverySa
     for (const Vec3& s : samples) sampled = std::min(sampled, length(p - s));
     EXPECT_LE(d, sampled + 1e-12) << trial;  // no sample is nearer
     EXPECT_GE(d, sampled - 2e-4) << trial;   // and the samples (spaced about 0.01) come near it
-    EXPECT_EQ(insideEllipsoid(shape, p), implicit > 0 && [&] {
-      double q = 0;
-      for (int i = 0; i < 3; ++i) q += std::pow(dot(p - shape.center, shape.axes[i]) / shape.semi[i], 2);
-      return q < 1;
-    }());
+    EXPECT_EQ(
+        insideEllipsoid(shape, p), implicit > 0 && [&] {
+          double q = 0;
+          for (int i = 0; i < 3; ++i) q += std::pow(dot(p - shape.center, shape.axes[i]) / shape.semi[i], 2);
+          return q < 1;
+        }());
   }
 }
 

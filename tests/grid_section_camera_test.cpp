@@ -34,8 +34,6 @@ Scene cameraScene(CameraKind kind) {
   return s;
 }
 
-
-
 std::string section(uint8_t span, uint64_t size = 1) {
   std::string out(kSectionBytes, '\0');
   const uint32_t tag = 4;

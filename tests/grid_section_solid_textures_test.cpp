@@ -49,14 +49,12 @@ Scene solidTexturedScene() {
   return s;
 }
 
-
 // Offset of the section body: it is written last, and its size follows from its counts.
 size_t bodyOffset(const Scene& s) {
   size_t textured = 0;
   for (const Material& m : s.materials) textured += m.solidTexture != kNoSolidTexture;
   return 8 + s.solidTextures.size() * kTextureBytes + 8 + textured * 8;
 }
-
 
 TEST(GridSectionSolidTextures, RoundTripIsExactAndRendersTheSame) {
   const Scene s = solidTexturedScene();

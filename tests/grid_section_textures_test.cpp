@@ -42,8 +42,6 @@ Scene texturedScene() {
   return scene;
 }
 
-
-
 template <typename T>
 std::string patched(const std::string& bytes, size_t at, T value) {
   std::string out = bytes;

@@ -106,8 +106,9 @@ TEST(RenderGridVsBruteForce, RandomScenesAndCamerasInsideAndOutside) {
       ro.camera.orthoHeight = 2.5;
       for (OverlapMethod m : {OverlapMethod::Exact, OverlapMethod::Sat, OverlapMethod::BBox}) {
         const Grid grid = voxelizeWith(scene, {dim(rng), dim(rng), dim(rng)}, m);
-        EXPECT_EQ(differingPixels(renderWith(scene, grid, AccelKind::Grid, ro), renderWith(scene, grid, AccelKind::None, ro)),
-                  0)
+        EXPECT_EQ(
+            differingPixels(renderWith(scene, grid, AccelKind::Grid, ro), renderWith(scene, grid, AccelKind::None, ro)),
+            0)
             << "seed " << seed << " camera " << cam << " " << methodName(m);
         ++checked;
       }

@@ -13,7 +13,8 @@
 
 namespace vox::testing {
 
-inline Grid voxelizeWith(const Scene& scene, std::array<uint32_t, 3> dims, OverlapMethod method = OverlapMethod::Exact) {
+inline Grid voxelizeWith(const Scene& scene, std::array<uint32_t, 3> dims,
+                         OverlapMethod method = OverlapMethod::Exact) {
   VoxelizeOptions o;
   o.dims = dims;
   o.method = method;

@@ -6,12 +6,14 @@ namespace vox::export_tool {
 
 void addOptions(CLI::App& app, Options& opt) {
   app.add_option("grid", opt.grid, "Input grid file (.vgrid)")->required();
-  app.add_option("-o,--output", opt.output,
-                 "Output mesh: .ply (binary unless --ascii, face colours), .obj (vertex colours), .off (face "
-                 "colours), .stl (binary unless --ascii, no colours), .glb/.gltf (vertex colours); voxels: .binvox "
-                 "(binvox, cubic voxels), .vox (MagicaVoxel, palette from --color), .vdb (OpenVDB grids density (or the "
-                 "volume fractions) and count, and a level set `surface` of the --sdf distances), .npz (numpy: dense "
-                 "occupancy, solid, sdf, fraction, bounds, dims, transform); .html: an interactive viewer page (three.js inside, opens from disk, no network)")
+  app.add_option(
+         "-o,--output", opt.output,
+         "Output mesh: .ply (binary unless --ascii, face colours), .obj (vertex colours), .off (face "
+         "colours), .stl (binary unless --ascii, no colours), .glb/.gltf (vertex colours); voxels: .binvox "
+         "(binvox, cubic voxels), .vox (MagicaVoxel, palette from --color), .vdb (OpenVDB grids density (or the "
+         "volume fractions) and count, and a level set `surface` of the --sdf distances), .npz (numpy: dense "
+         "occupancy, solid, sdf, fraction, bounds, dims, transform); .html: an interactive viewer page (three.js "
+         "inside, opens from disk, no network)")
       ->required();
   app.add_option("--faces", opt.faces,
                  "all: a closed cube of 12 triangles per voxel; exposed (default): the quads between voxels and "

@@ -27,7 +27,8 @@ void addOptions(CLI::App& app, Options& opt) {
            // Given bare, CLI11 hands over no value or an empty one: the default band.
            if (half.empty() || half[0].empty()) return void(opt.sdf = 3.0);
            double value = 0;
-           if (!CLI::detail::lexical_cast(half[0], value)) throw CLI::ValidationError("--sdf", "HALF " + half[0] + " is not a number");
+           if (!CLI::detail::lexical_cast(half[0], value))
+             throw CLI::ValidationError("--sdf", "HALF " + half[0] + " is not a number");
            opt.sdf = value;
          },
          "Also store the signed distance (world units, negative inside as --fill decides) at the centre of every "

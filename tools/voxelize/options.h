@@ -20,8 +20,8 @@ struct Options {
   std::string method = "exact";
   bool stats = false;
   bool fill = false;
-  std::optional<double> sdf;  // --sdf [HALF]: the signed distance band's half-width in cell widths
-  bool fraction = false;      // --fraction: volume fractions of the occupied cells
+  std::optional<double> sdf;     // --sdf [HALF]: the signed distance band's half-width in cell widths
+  bool fraction = false;         // --fraction: volume fractions of the occupied cells
   std::vector<uint32_t> bricks;  // --bricks BX BY BZ: write a grid set
   cli::CommonOptions common;
 };

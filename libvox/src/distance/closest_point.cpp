@@ -112,9 +112,12 @@ double bisectShiftedRoot(const double (&r)[N], const double (&z)[N], double g) {
       const double ratio = n[i] / (t + q[i]);
       f += ratio * ratio;
     }
-    if (f > 0) t0 = t;
-    else if (f < 0) t1 = t;
-    else break;
+    if (f > 0)
+      t0 = t;
+    else if (f < 0)
+      t1 = t;
+    else
+      break;
   }
   return t;
 }

@@ -13,8 +13,7 @@
 
 namespace vox {
 
-InsideTest::InsideTest(const Scene& scene)
-    : tree_(buildWindingTree({scene.triangles.data(), scene.triangles.size()})) {
+InsideTest::InsideTest(const Scene& scene) : tree_(buildWindingTree({scene.triangles.data(), scene.triangles.size()})) {
   shapes_.reserve(scene.spheres.size());
   for (const Sphere& s : scene.spheres) shapes_.push_back(ellipsoidShape(s));
 }
@@ -27,15 +26,15 @@ bool InsideTest::inside(const Vec3& p) const {
 
 void checkSdfHalfWidth(double halfWidth, const char* what) {
   if (!(halfWidth > 0) || !(halfWidth <= kMaxSdfHalfWidth))
-    fail<UsageError>(what, ": half-width ", halfWidth, " must be a number in (0, ", kMaxSdfHalfWidth,
-                     "] cell widths");
+    fail<UsageError>(what, ": half-width ", halfWidth, " must be a number in (0, ", kMaxSdfHalfWidth, "] cell widths");
 }
 
 Vec3 cellCentre(const Grid& grid, uint32_t i, uint32_t j, uint32_t k) {
   const uint32_t ijk[3] = {i, j, k};
   Vec3 c;
   for (int a = 0; a < 3; ++a)
-    c.at(a) = 0.5 * (cellBoundary(grid.bounds, grid.dims, a, ijk[a]) + cellBoundary(grid.bounds, grid.dims, a, ijk[a] + 1));
+    c.at(a) =
+        0.5 * (cellBoundary(grid.bounds, grid.dims, a, ijk[a]) + cellBoundary(grid.bounds, grid.dims, a, ijk[a] + 1));
   return c;
 }
 
@@ -54,7 +53,8 @@ struct Centres {
     for (int a = 0; a < 3; ++a) {
       axis[a].resize(grid.dims[a]);
       for (uint32_t i = 0; i < grid.dims[a]; ++i)
-        axis[a][i] = 0.5 * (cellBoundary(grid.bounds, grid.dims, a, i) + cellBoundary(grid.bounds, grid.dims, a, i + 1));
+        axis[a][i] =
+            0.5 * (cellBoundary(grid.bounds, grid.dims, a, i) + cellBoundary(grid.bounds, grid.dims, a, i + 1));
     }
   }
 };

@@ -18,9 +18,10 @@ namespace {
 // One .npy file (format version 1.0): magic, header length, a Python dict literal padded with spaces to a multiple
 // of 64 bytes and ended by a newline, then the raw little-endian data.
 std::string npyHeader(const char* descr, const std::vector<uint64_t>& shape, bool fortran) {
-  std::string dict = std::string("{'descr': '") + descr + "', 'fortran_order': " + (fortran ? "True" : "False") +
-                     ", 'shape': (";
-  for (size_t i = 0; i < shape.size(); ++i) dict += std::to_string(shape[i]) + (shape.size() == 1 || i + 1 < shape.size() ? ", " : "");
+  std::string dict =
+      std::string("{'descr': '") + descr + "', 'fortran_order': " + (fortran ? "True" : "False") + ", 'shape': (";
+  for (size_t i = 0; i < shape.size(); ++i)
+    dict += std::to_string(shape[i]) + (shape.size() == 1 || i + 1 < shape.size() ? ", " : "");
   dict += "), }";
   const size_t unpadded = 10 + dict.size() + 1;
   dict.append((64 - unpadded % 64) % 64, ' ');
@@ -94,10 +95,10 @@ class ZipWriter {
   };
   // The fields local headers and central directory entries share, from "version needed" to the extra field length.
   static void putCommon(std::string& s, const Entry& e) {
-    put<uint16_t>(s, 20);  // version needed: 2.0
-    put<uint16_t>(s, 0);   // flags
-    put<uint16_t>(s, 0);   // stored
-    put<uint16_t>(s, 0);   // time
+    put<uint16_t>(s, 20);    // version needed: 2.0
+    put<uint16_t>(s, 0);     // flags
+    put<uint16_t>(s, 0);     // stored
+    put<uint16_t>(s, 0);     // time
     put<uint16_t>(s, 0x21);  // date: 1980-01-01
     put<uint32_t>(s, e.crc);
     put<uint32_t>(s, e.size);

@@ -235,9 +235,7 @@ void streamPayload(const Scene& scene, const Grid& grid, const EncodedCellTable&
 
 }  // namespace
 
-uint32_t gridFileVersionFor(const Grid& grid) {
-  return grid.sdfHalfWidth > 0 || !grid.fractions.empty() ? 4 : 3;
-}
+uint32_t gridFileVersionFor(const Grid& grid) { return grid.sdfHalfWidth > 0 || !grid.fractions.empty() ? 4 : 3; }
 
 std::string encodeGridFile(const Scene& scene, const Grid& grid, uint32_t version) {
   if (version == 0) version = gridFileVersionFor(grid);

@@ -96,7 +96,8 @@ double sceneVolume(const Scene& sc) {
   for (const Sphere& sp : sc.spheres) {
     const auto& m = sp.transform.m;
     const double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
-                       m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+                       m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                       m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
     v += 4.0 / 3.0 * M_PI * sp.radius * sp.radius * sp.radius * std::fabs(det);
   }
   return v;
@@ -132,8 +133,7 @@ void plainDistances(std::ostream& out, const InfoSource& in) {
     out << "distance_band: " << g.sdfKeys.size() << " cells within " << num(g.sdfHalfWidth)
         << " cell widths, signed distances " << num(d.bandMin) << " to " << num(d.bandMax) << "\n";
   if (!g.fractions.empty())
-    out << "fraction_volume: " << num(d.fractionVolume) << " (the scene's own volume: " << num(d.sceneVolume)
-        << ")\n";
+    out << "fraction_volume: " << num(d.fractionVolume) << " (the scene's own volume: " << num(d.sceneVolume) << ")\n";
 }
 
 void jsonDistances(std::ostream& out, const InfoSource& in) {

@@ -22,7 +22,7 @@ namespace vox {
 inline constexpr double kMaxSdfHalfWidth = 64;
 
 struct SdfOptions {
-  double halfWidth = 3;  // in smallest cell edges (OpenVDB's default band)
+  double halfWidth = 3;                     // in smallest cell edges (OpenVDB's default band)
   uint64_t memoryLimitBytes = 16ull << 30;  // scratch beyond this throws LimitError
   // Called with a fraction in [0, 1], possibly from worker threads; return false to cancel (throws vox::Error).
   std::function<bool(double)> progress;
@@ -34,9 +34,9 @@ struct SdfBand {
 };
 
 struct SdfReport {
-  uint64_t candidates = 0;      // (cell, primitive) distances evaluated within the band
-  uint64_t insideQueries = 0;   // inside tests at occupied cells' centres
-  uint64_t planesLeftOut = 0;   // planes of the scene, which have no distance here
+  uint64_t candidates = 0;     // (cell, primitive) distances evaluated within the band
+  uint64_t insideQueries = 0;  // inside tests at occupied cells' centres
+  uint64_t planesLeftOut = 0;  // planes of the scene, which have no distance here
 };
 
 // Which side of the solid a point is on: inside a sphere or an ellipsoid, or where the triangles' generalized

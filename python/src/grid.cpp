@@ -38,6 +38,26 @@ py::array_t<int32_t> indicesOf(const Grid& g, std::span<const uint64_t> keys) {
   return out;
 }
 
+// The --sdf band: (indices (B, 3) int32 [i, j, k] in ascending key, values (B,) float64); empty arrays without one.
+py::tuple sdfBand(PyGrid& self) {
+  const Grid& g = self.grid();
+  const size_t n = g.sdfKeys.size();
+  checkArray(self, double(n) * 20, "sdf");
+  py::array_t<int32_t> indices({py::ssize_t(n), py::ssize_t(3)});
+  py::array_t<double> values{py::ssize_t(n)};
+  int32_t* p = indices.mutable_data();
+  double* v = values.mutable_data();
+  {
+    py::gil_scoped_release release;
+    for (size_t b = 0; b < n; ++b, p += 3) {
+      const auto ijk = vox::cellIndex(g.dims, g.sdfKeys[b]);
+      p[0] = int32_t(ijk[0]), p[1] = int32_t(ijk[1]), p[2] = int32_t(ijk[2]);
+      v[b] = g.sdfValues[b];
+    }
+  }
+  return py::make_tuple(indices, values);
+}
+
 py::array_t<int32_t> solidIndices(PyGrid& self) {
   const Grid& g = self.grid();
   const uint64_t n = g.solidCount();
@@ -244,6 +264,12 @@ Arrays returned by properties are computed on each access unless noted (keep the
       .def_property_readonly(
           "indices", [](const PyGrid& s) { return indicesOf(s.grid(), s.grid().cellKeys); },
           "Occupied cells, (N, 3) int32 [i, j, k], in the file's order (ascending key i + nx (j + ny k)).")
+      .def_property_readonly("sdf", &sdfBand,
+                             "The signed distance band of voxelize(..., sdf=HALF): (indices (B, 3) int32 [i, j, k], "
+                             "ascending key; values (B,) float64, negative inside). Empty arrays without one.")
+      .def_property_readonly(
+          "sdf_half_width", [](PyGrid& self) { return self.grid().sdfHalfWidth; },
+          "The band's half-width in smallest cell edges (0.0 without distances).")
       .def_property_readonly("solid_indices", &solidIndices,
                              "Solid cells (fill), (M, 3) int32 [i, j, k], ascending key. Empty without fill. "
                              "LimitError when they would not fit in memory.")

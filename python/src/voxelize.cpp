@@ -9,6 +9,7 @@
 #include "vox/export/voxel_runs.h"
 #include "vox/import/import.h"
 #include "vox/io/input_file.h"
+#include "vox/distance/sdf.h"
 #include "vox/voxelize/fill.h"
 #include "vox/voxelize/voxelize.h"
 
@@ -145,7 +146,8 @@ vox::Vec3 pitchArg(const py::object& pitch) {
 
 std::shared_ptr<PyGrid> voxelize(const py::object& source, const py::object& resolution, const py::object& dims,
                                  const py::object& pitch, const py::object& bounds, const py::object& method,
-                                 const py::object& fill, const py::object& threads, const py::object& progress) {
+                                 const py::object& fill, const py::object& sdf, const py::object& threads,
+                                 const py::object& progress) {
   Source src = sourceArg(source, "source", "");
   vox::VoxelizeOptions vo;
   vo.method = enumArg(method, "method", vox::parseMethod);
@@ -157,15 +159,22 @@ std::shared_ptr<PyGrid> voxelize(const py::object& source, const py::object& res
   std::optional<Pitch> pitchSize;
   if (!pitch.is_none()) pitchSize = Pitch{pitchArg(pitch)};
   const bool doFill = fillArg(fill);
+  std::optional<double> sdfHalfWidth;
+  if (!sdf.is_none()) {
+    sdfHalfWidth = floatArg(sdf, "sdf");
+    vox::checkSdfHalfWidth(*sdfHalfWidth, "sdf");
+  }
   const auto nThreads = threadsArg(threads);
   vo.memoryLimitBytes = memoryBudget();
   Interrupt interrupt(progressCallable(progress, "voxelizing"));
-  vo.progress = [&](double f) { return interrupt.poll(doFill ? 0.7 * f : f); };
+  const double voxelizeShare = sdfHalfWidth ? 0.3 : (doFill ? 0.7 : 1.0);
+  vo.progress = [&](double f) { return interrupt.poll(voxelizeShare * f); };
   vox::FillReport report;
   vox::Grid grid = runLong(interrupt, nThreads, [&] {
     const vox::Scene& scene = src.load();
     if (pitchSize) applyPitch(*pitchSize, scene, vo);
     return namedAfter(src, [&] {
+      if (sdfHalfWidth) vo = vox::withCubicCells(scene, vo);  // as vox-voxelize --sdf: a level set's cubic cells
       vox::Grid g = vox::voxelizeScene(scene, vo);
       if (doFill) {
         vox::FillOptions fo;
@@ -173,10 +182,19 @@ std::shared_ptr<PyGrid> voxelize(const py::object& source, const py::object& res
         fo.progress = [&](double f) { return interrupt.poll(0.7 + 0.3 * f); };
         report = vox::fillSolid(g, scene, fo);
       }
+      if (sdfHalfWidth) {
+        vox::SdfOptions so;
+        so.halfWidth = *sdfHalfWidth;
+        so.memoryLimitBytes = vo.memoryLimitBytes;
+        so.progress = [&](double f) { return interrupt.poll(0.3 + 0.7 * f); };
+        vox::storeSignedDistances(g, scene, so, doFill);
+      }
       return g;
     });
   });
   for (const std::string& w : src.scene.warnings) warn(src.describe(w));
+  if (sdfHalfWidth && !src.scene.planes.empty())
+    warn(src.describe(std::to_string(src.scene.planes.size()) + " planes are left out of the signed distances"));
   if (doFill)
     if (const std::string w = vox::fillWarning(report); !w.empty()) warn(src.describe("fill: " + w));
   return std::make_shared<PyGrid>(vox::GridFile{std::move(src.scene), std::move(grid)}, src.name);
@@ -302,8 +320,8 @@ py::object voxelizeBatch(const py::object& sources, const py::object& resolution
 void bindVoxelize(py::module_& m) {
   m.def("voxelize", &voxelize, py::arg("source"), py::kw_only(), py::arg("resolution") = py::none(),
         py::arg("dims") = py::none(), py::arg("pitch") = py::none(), py::arg("bounds") = py::none(),
-        py::arg("method") = "exact", py::arg("fill") = py::none(), py::arg("threads") = py::none(),
-        py::arg("progress") = false, R"doc(
+        py::arg("method") = "exact", py::arg("fill") = py::none(), py::arg("sdf") = py::none(),
+        py::arg("threads") = py::none(), py::arg("progress") = false, R"doc(
 Puts every triangle and sphere of a scene into the closed cells it meets, as `vox-voxelize` does (the same cells and
 primitive ids).
 
@@ -318,6 +336,8 @@ bounds: ((x0, y0, z0), (x1, y1, z1)); default: the bounds of the primitives. Pri
     traced separately.
 method: 'exact' (CGAL exact predicates, default), 'sat', 'bbox' or 'center'.
 fill: True also marks the empty cells inside closed surfaces as solid (generalized winding number for open meshes).
+sdf: a half-width HALF in (0, 64] cell widths: also the signed distance at the centre of every cell within HALF
+    smallest cell edges of the surface (vox-voxelize --sdf; Grid.sdf; docs/distance.md).
 threads: worker threads (default: all cores).
 progress: True for a tqdm bar (when tqdm is installed), or a callable taking the fraction done.
 

@@ -17,8 +17,8 @@ void checkDistanceFlags(const Options& opt);
 // `vo` unchanged otherwise.
 VoxelizeOptions cubicCellsForDistances(const Options& opt, const Scene& scene, VoxelizeOptions vo);
 
-// With --sdf or --fraction: fills a scratch copy when --fill was not asked for (the sign and the solid cells come
-// from the fill), then stores the band and the fractions in `grid`, with progress bars.
+// With --sdf: stores the band in `grid` (storeSignedDistances; the fill runs on the side without --fill), with a
+// progress bar and a warning for planes. --fraction is refused until the volume fractions exist.
 void addDistances(const Options& opt, const Scene& scene, uint64_t memoryLimitBytes, Grid& grid);
 
 }  // namespace vox::voxelize_tool

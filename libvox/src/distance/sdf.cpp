@@ -258,4 +258,40 @@ SdfBand signedDistanceBand(const Grid& grid, const Scene& scene, const SdfOption
   return band;
 }
 
+VoxelizeOptions withCubicCells(const Scene& scene, VoxelizeOptions options) {
+  if (!options.resolution || options.bounds || options.dims) return options;
+  const Grid plan = planGrid(scene, options);
+  double cell = 0;
+  for (int a = 0; a < 3; ++a) cell = std::max(cell, (plan.bounds.hi[a] - plan.bounds.lo[a]) / *options.resolution);
+  Box cubic;
+  for (int a = 0; a < 3; ++a) {
+    const double extent = plan.bounds.hi[a] - plan.bounds.lo[a];
+    const double n = std::max(1.0, std::ceil(extent / cell - 1e-9));
+    const double centre = 0.5 * (plan.bounds.lo[a] + plan.bounds.hi[a]);
+    cubic.lo.at(a) = centre - 0.5 * n * cell;
+    cubic.hi.at(a) = cubic.lo[a] + n * cell;
+  }
+  options.bounds = cubic;
+  return options;
+}
+
+void storeSignedDistances(Grid& grid, const Scene& scene, const SdfOptions& options, bool filled) {
+  checkSdfHalfWidth(options.halfWidth, "--sdf");
+  std::vector<CellRun> ownRuns;
+  SdfOptions bandOptions = options;
+  if (!filled) {
+    ownRuns = std::move(grid.solidRuns);
+    FillOptions fo;
+    fo.memoryLimitBytes = options.memoryLimitBytes;
+    if (options.progress) fo.progress = [&](double f) { return options.progress(f / 3); };
+    fillSolid(grid, scene, fo);
+    if (options.progress) bandOptions.progress = [&](double f) { return options.progress((1 + 2 * f) / 3); };
+  }
+  SdfBand band = signedDistanceBand(grid, scene, bandOptions);
+  if (!filled) grid.solidRuns = std::move(ownRuns);
+  grid.sdfHalfWidth = options.halfWidth;
+  grid.sdfKeys = std::move(band.keys);
+  grid.sdfValues = std::move(band.values);
+}
+
 }  // namespace vox

@@ -13,6 +13,7 @@
 #include "vox/core/math.h"
 #include "vox/core/scene.h"
 #include "vox/distance/closest_point.h"
+#include "vox/voxelize/voxelize.h"
 #include "vox/voxelize/winding_number.h"
 
 namespace vox {
@@ -65,5 +66,15 @@ Vec3 cellCentre(const Grid& grid, uint32_t i, uint32_t j, uint32_t k);
 // limit, vox::Error when cancelled.
 SdfBand signedDistanceBand(const Grid& grid, const Scene& scene, const SdfOptions& options = {},
                            SdfReport* report = nullptr);
+
+// Options whose cells are exactly cubic, for distances: with a resolution and no bounds, the bounds grown about the
+// scene's (by less than a cell on each shorter axis) so that every cell has the longest axis' edge, as an OpenVDB
+// level set needs (vox-export .vdb). Options with dims or bounds are returned unchanged. Throws as planGrid.
+VoxelizeOptions withCubicCells(const Scene& scene, VoxelizeOptions options);
+
+// signedDistanceBand stored in `grid` (sdfHalfWidth, sdfKeys, sdfValues), what vox-voxelize --sdf and
+// libvox.voxelize(sdf=) do. `filled`: grid.solidRuns are fillSolid's for this scene; otherwise the fill runs on the
+// side first (its runs are not kept, and its progress is the first third of options.progress).
+void storeSignedDistances(Grid& grid, const Scene& scene, const SdfOptions& options, bool filled);
 
 }  // namespace vox

@@ -1,0 +1,50 @@
+"""libvox.voxelize(..., sdf=HALF) and Grid.sdf (issue 38): the CLI's band bit for bit, the unit cube's exact
+distances, pickling, and wrong values refused."""
+import pickle
+
+import numpy as np
+import pytest
+
+import libvox
+from conftest import cli_voxelize
+
+CUBE = __import__("pathlib").Path(__file__).resolve().parents[1] / "data" / "unit_cube.obj"
+
+
+def test_band_equals_the_cli_and_the_cubes_exact_distances(tools, tmp_path):
+    g = libvox.voxelize(CUBE, resolution=10, sdf=3)
+    indices, values = g.sdf
+    assert indices.dtype == np.int32 and values.dtype == np.float64
+    assert indices.shape == (len(values), 3) and len(values) > 0
+    assert g.sdf_half_width == 3.0
+    cli = libvox.load(cli_voxelize(tools, tmp_path, CUBE, "--res", "10", "--sdf"))
+    assert np.array_equal(cli.sdf[0], indices) and np.array_equal(cli.sdf[1], values)
+    lo, hi = np.array(g.bounds[0]), np.array(g.bounds[1])
+    cell = (hi - lo) / np.array(g.dims)
+    assert np.allclose(cell, cell[0], rtol=0, atol=1e-15)  # --sdf with resolution: cubic cells
+    c = lo + (indices + 0.5) * cell
+    inside = np.all((c > 0) & (c < 1), axis=1)
+    outside_d = np.linalg.norm(np.maximum(np.maximum(-c, c - 1), 0), axis=1)
+    expected = np.where(inside, -np.min(np.minimum(c, 1 - c), axis=1), outside_d)
+    assert np.max(np.abs(values - expected)) < 1e-12
+    assert np.all(np.abs(values) <= 3 * cell[0] * (1 + 1e-12))
+
+
+def test_band_pickles_and_is_empty_without_sdf():
+    g = libvox.voxelize(CUBE, resolution=8, sdf=1.5)
+    back = pickle.loads(pickle.dumps(g))
+    assert np.array_equal(back.sdf[1], g.sdf[1]) and back.sdf_half_width == 1.5
+    plain = libvox.voxelize(CUBE, resolution=8)
+    assert plain.sdf[0].shape == (0, 3) and plain.sdf[1].shape == (0,) and plain.sdf_half_width == 0.0
+
+
+@pytest.mark.parametrize("bad", [0, -1, 65, float("nan"), float("inf")])
+def test_bad_half_widths_are_usage_errors(bad):
+    with pytest.raises(libvox.UsageError, match="sdf"):
+        libvox.voxelize(CUBE, resolution=4, sdf=bad)
+
+
+@pytest.mark.parametrize("bad", ["3", True, [3]])
+def test_wrong_types_are_type_errors(bad):
+    with pytest.raises(TypeError, match="sdf"):
+        libvox.voxelize(CUBE, resolution=4, sdf=bad)

@@ -12,6 +12,9 @@
 namespace vox::voxelize_tool {
 
 void checkDistanceFlags(const Options& opt) {
+  // Refused before any work until the exact volume fractions exist (issue 38); the grid file, vox-info and the
+  // exports already carry them.
+  if (opt.fraction) fail<UsageError>("--fraction: volume fractions are not available in this build yet");
   if (opt.sdf) checkSdfHalfWidth(*opt.sdf, "--sdf");
   if ((opt.sdf || opt.fraction) && !opt.bricks.empty())
     fail<UsageError>("--sdf and --fraction write a single grid file; grid sets (--bricks) hold no distances");
@@ -39,7 +42,6 @@ void addDistances(const Options& opt, const Scene& scene, uint64_t memoryLimitBy
     storeSignedDistances(grid, scene, so, opt.fill);
     bar.finish();
   }
-  if (opt.fraction) fail<UsageError>("--fraction is not available in this build yet");
 }
 
 }  // namespace vox::voxelize_tool

@@ -8,7 +8,8 @@
 
 namespace vox::voxelize_tool {
 
-// Checks the flags before any work: --sdf's half-width, and neither flag with --bricks (grid sets hold no distances).
+// Checks the flags before any work: --sdf's half-width, neither flag with --bricks (grid sets hold no distances),
+// and --fraction, refused until the volume fractions exist.
 // Throws UsageError.
 void checkDistanceFlags(const Options& opt);
 
@@ -18,7 +19,7 @@ void checkDistanceFlags(const Options& opt);
 VoxelizeOptions cubicCellsForDistances(const Options& opt, const Scene& scene, VoxelizeOptions vo);
 
 // With --sdf: stores the band in `grid` (storeSignedDistances; the fill runs on the side without --fill), with a
-// progress bar and a warning for planes. --fraction is refused until the volume fractions exist.
+// progress bar and a warning for planes.
 void addDistances(const Options& opt, const Scene& scene, uint64_t memoryLimitBytes, Grid& grid);
 
 }  // namespace vox::voxelize_tool

@@ -74,6 +74,10 @@ done
 [ $? = 1 ] && grep -q 'cubic cells' "$tmp/err" && [ ! -e "$tmp/flat.vdb" ] || fail "non-cubic level set: $(cat "$tmp/err")"
 "$build/vox-export" "$tmp/flat.vgrid" -o "$tmp/flat.npz" -q || fail "non-cubic .npz"
 
+# --fraction: refused before any work until the exact fractions exist.
+"$build/vox-voxelize" "$cube" -o "$tmp/f.vgrid" --res 8 --fraction 2>"$tmp/err"
+[ $? = 1 ] && [ ! -e "$tmp/f.vgrid" ] && grep -q 'fraction' "$tmp/err" || fail "--fraction: $(cat "$tmp/err")"
+
 # A scene with a plane: distances leave it out and say so.
 "$build/vox-voxelize" "$src/data/6837/scenes/scene2_06_plane.txt" -o "$tmp/p.vgrid" --res 8 --sdf 2>"$tmp/err" ||
   fail "plane scene: $(cat "$tmp/err")"

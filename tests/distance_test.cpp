@@ -206,8 +206,7 @@ void expectBandExact(const Scene& scene, const Grid& grid, double halfWidth, con
   for (int a = 0; a < 3; ++a) h = std::min(h, (grid.bounds.hi[a] - grid.bounds.lo[a]) / grid.dims[a]);
   size_t b = 0, signErrors = 0;
   for (uint64_t key = 0; key < grid.cellCount(); ++key) {
-    const auto ijk = cellIndex(grid.dims, key);
-    const Vec3 c = cellCentre(grid, ijk[0], ijk[1], ijk[2]);
+    const Vec3 c = cellCentre(grid, key);
     double best = INFINITY;
     for (const Triangle& t : scene.triangles) best = std::min(best, ourTriangleDistance(t.v[0], t.v[1], t.v[2], c));
     const bool inBand = best <= halfWidth * h;
@@ -269,8 +268,7 @@ TEST(SdfBand, SpheresAndEllipsoidsAgainstTheirClosedForms) {
   const SdfBand band = signedDistanceBand(grid, s);
   ASSERT_FALSE(band.keys.empty());
   for (size_t b = 0; b < band.keys.size(); ++b) {
-    const auto ijk = cellIndex(grid.dims, band.keys[b]);
-    const Vec3 c = cellCentre(grid, ijk[0], ijk[1], ijk[2]);
+    const Vec3 c = cellCentre(grid, band.keys[b]);
     EXPECT_NEAR(band.values[b], length(c - ball.center) - 0.3, 1e-15);
   }
   Scene e;
@@ -283,8 +281,7 @@ TEST(SdfBand, SpheresAndEllipsoidsAgainstTheirClosedForms) {
   const SdfBand eb = signedDistanceBand(eg, e);
   ASSERT_FALSE(eb.keys.empty());
   for (size_t b = 0; b < eb.keys.size(); ++b) {
-    const auto ijk = cellIndex(eg.dims, eb.keys[b]);
-    const Vec3 c = cellCentre(eg, ijk[0], ijk[1], ijk[2]);
+    const Vec3 c = cellCentre(eg, eb.keys[b]);
     const double d = length(c - closestPointOnEllipsoid(shape, c));
     EXPECT_EQ(eb.values[b], insideEllipsoid(shape, c) ? -d : d);
   }
@@ -299,8 +296,7 @@ TEST(SdfBand, OpenMeshesTakeTheSignOfTheWindingNumber) {
   size_t checked = 0;
   for (size_t b = 0; b < band.keys.size(); ++b) {
     if (findCell(grid, band.keys[b]) < 0) continue;  // empty cells follow the fill, tested by the fill's tests
-    const auto ijk = cellIndex(grid.dims, band.keys[b]);
-    const Vec3 c = cellCentre(grid, ijk[0], ijk[1], ijk[2]);
+    const Vec3 c = cellCentre(grid, band.keys[b]);
     const double w = windingNumberExact({open.triangles.data(), open.triangles.size()}, c);
     if (band.values[b] != 0) {
       EXPECT_EQ(band.values[b] < 0, std::fabs(w) >= kWindingThreshold) << b;

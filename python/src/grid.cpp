@@ -109,9 +109,7 @@ py::array_t<double> points(const PyGrid& self) {
   double* p = out.mutable_data();
   for (size_t c = 0; c < g.occupiedCount(); ++c) {
     const auto ijk = vox::cellIndex(g.dims, g.cellKeys[c]);
-    for (int a = 0; a < 3; ++a)
-      p[3 * c + a] = 0.5 * (vox::cellBoundary(g.bounds, g.dims, a, ijk[a]) +
-                            vox::cellBoundary(g.bounds, g.dims, a, int64_t(ijk[a]) + 1));
+    for (int a = 0; a < 3; ++a) p[3 * c + a] = vox::cellCentreOnAxis(g.bounds, g.dims, a, ijk[a]);
   }
   return out;
 }

@@ -37,6 +37,13 @@ Box cellBox(const Grid& grid, uint32_t i, uint32_t j, uint32_t k) {
   return box;
 }
 
+Vec3 cellCentre(const Grid& grid, uint64_t key) {
+  const auto ijk = cellIndex(grid.dims, key);
+  Vec3 c;
+  for (int a = 0; a < 3; ++a) c.at(a) = cellCentreOnAxis(grid.bounds, grid.dims, a, ijk[a]);
+  return c;
+}
+
 int64_t findCell(const Grid& grid, uint64_t key) {
   const auto it = std::lower_bound(grid.cellKeys.begin(), grid.cellKeys.end(), key);
   if (it == grid.cellKeys.end() || *it != key) return -1;

@@ -119,4 +119,10 @@ Mat4 rotation(const Vec3& axis, double degrees) {
   return out;
 }
 
+double linearDeterminant(const Mat4& t) {
+  const auto& m = t.m;
+  return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+         m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+}
+
 }  // namespace vox

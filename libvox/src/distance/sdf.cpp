@@ -29,32 +29,21 @@ void checkSdfHalfWidth(double halfWidth, const char* what) {
     fail<UsageError>(what, ": half-width ", halfWidth, " must be a number in (0, ", kMaxSdfHalfWidth, "] cell widths");
 }
 
-Vec3 cellCentre(const Grid& grid, uint32_t i, uint32_t j, uint32_t k) {
-  const uint32_t ijk[3] = {i, j, k};
-  Vec3 c;
-  for (int a = 0; a < 3; ++a)
-    c.at(a) =
-        0.5 * (cellBoundary(grid.bounds, grid.dims, a, ijk[a]) + cellBoundary(grid.bounds, grid.dims, a, ijk[a] + 1));
-  return c;
-}
-
 namespace {
 
 struct Candidate {
   uint64_t key;
-  double d2;  // squared distance from the cell's centre to one primitive
-  bool operator<(const Candidate& o) const { return key != o.key ? key < o.key : d2 < o.d2; }
+  double d2;  // squared distance from the cell's centre to its nearest primitive
+  bool operator<(const Candidate& o) const { return key < o.key; }
 };
 
-// The cells' centres along each axis, computed once: cellCentre for every index.
+// The cells' centres along each axis, computed once (cellCentreOnAxis for every index).
 struct Centres {
   std::array<std::vector<double>, 3> axis;
   explicit Centres(const Grid& grid) {
     for (int a = 0; a < 3; ++a) {
       axis[a].resize(grid.dims[a]);
-      for (uint32_t i = 0; i < grid.dims[a]; ++i)
-        axis[a][i] =
-            0.5 * (cellBoundary(grid.bounds, grid.dims, a, i) + cellBoundary(grid.bounds, grid.dims, a, i + 1));
+      for (uint32_t i = 0; i < grid.dims[a]; ++i) axis[a][i] = cellCentreOnAxis(grid.bounds, grid.dims, a, i);
     }
   }
 };
@@ -211,50 +200,38 @@ std::vector<Candidate> bandCandidates(const Grid& grid, const Scene& scene, doub
 
 }  // namespace
 
-SdfBand signedDistanceBand(const Grid& grid, const Scene& scene, const SdfOptions& options, SdfReport* report) {
+SdfBand signedDistanceBand(const Grid& grid, const Scene& scene, const SdfOptions& options) {
   checkSdfHalfWidth(options.halfWidth, "--sdf");
   const double reach = options.halfWidth * smallestCellEdge(grid);
   std::vector<Candidate> all = bandCandidates(grid, scene, reach, options);
-  tbb::parallel_sort(all.begin(), all.end());  // by key (each key once)
+  tbb::parallel_sort(all.begin(), all.end());  // tiles are disjoint: each key comes once
   SdfBand band;
-  for (size_t i = 0; i < all.size(); ++i)
-    if (i == 0 || all[i].key != all[i - 1].key) {
-      band.keys.push_back(all[i].key);
-      band.values.push_back(all[i].d2);
-    }
-  const uint64_t candidates = all.size();
+  band.keys.reserve(all.size());
+  band.values.reserve(all.size());
+  for (const Candidate& c : all) band.keys.push_back(c.key), band.values.push_back(c.d2);
   std::vector<Candidate>().swap(all);
   // Signs: an empty cell lies wholly on one side, which the fill decided; an occupied cell's centre is tested.
   const InsideTest insideTest(scene);
-  std::atomic<uint64_t> queries{0}, done{0};
+  std::atomic<uint64_t> done{0};
   std::atomic<bool> cancelled{false};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, band.keys.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
     if (cancelled) return;
-    uint64_t local = 0;
     for (size_t b = r.begin(); b < r.end(); ++b) {
       const uint64_t key = band.keys[b];
       const double d = std::sqrt(band.values[b]);
       bool inside;
       if (findCell(grid, key) >= 0) {
-        const auto ijk = cellIndex(grid.dims, key);
-        inside = d > 0 && insideTest.inside(cellCentre(grid, ijk[0], ijk[1], ijk[2]));
-        ++local;
+        inside = d > 0 && insideTest.inside(cellCentre(grid, key));
       } else {
         inside = isSolid(grid, key);
       }
       band.values[b] = inside ? -d : d;
     }
-    queries += local;
     const uint64_t finished = done += r.size();
     if (options.progress && !options.progress(0.8 + 0.2 * double(finished) / double(band.keys.size())))
       cancelled = true;
   });
   if (cancelled) fail<Error>("signed distances cancelled");
-  if (report) {
-    report->candidates = candidates;
-    report->insideQueries = queries;
-    report->planesLeftOut = scene.planes.size();
-  }
   return band;
 }
 

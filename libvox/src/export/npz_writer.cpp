@@ -3,7 +3,6 @@
 #include <zlib.h>
 
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <string>
 #include <vector>
@@ -73,16 +72,15 @@ class ZipWriter {
       put<uint32_t>(dir, e.offset);
       dir += e.name;
     }
-    put<uint32_t>(dir, 0x06054b50);
+    const uint32_t dirSize = uint32_t(dir.size());
+    put<uint32_t>(dir, 0x06054b50);  // end of central directory
     put<uint16_t>(dir, 0);
     put<uint16_t>(dir, 0);
     put<uint16_t>(dir, uint16_t(entries_.size()));
     put<uint16_t>(dir, uint16_t(entries_.size()));
-    put<uint32_t>(dir, 0);  // the central directory's size, set below
+    put<uint32_t>(dir, dirSize);
     put<uint32_t>(dir, uint32_t(start));
     put<uint16_t>(dir, 0);
-    const uint32_t dirSize = uint32_t(dir.size() - 22);
-    std::memcpy(&dir[dir.size() - 10], &dirSize, 4);
     write(dir.data(), dir.size());
   }
 

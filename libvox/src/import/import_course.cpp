@@ -70,12 +70,6 @@ struct Primitives {
   std::vector<Plane> planes;
 };
 
-double det3(const Mat4& t) {
-  const auto& m = t.m;
-  return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
-         m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-}
-
 // When the linear part L of `t` is a similarity (L^T L = s^2 I up to a relative 1e-12), returns s.
 std::optional<double> similarityScale(const Mat4& t) {
   double g[3][3];
@@ -522,7 +516,7 @@ class CourseParser {
       s.center = transformPoint(m, s.center);
       s.radius *= *scale;
     } else {
-      if (det3(m) == 0) failAt(t, "sphere under a singular transform");
+      if (linearDeterminant(m) == 0) failAt(t, "sphere under a singular transform");
       s.transform = m;  // an ellipsoid: the sphere stays in object space
     }
     out.spheres.push_back(s);
@@ -540,7 +534,7 @@ class CourseParser {
     if (m.isIdentity()) {
       p.normal = normalize(n);
     } else {
-      if (det3(m) == 0) failAt(t, "plane under a singular transform");
+      if (linearDeterminant(m) == 0) failAt(t, "plane under a singular transform");
       // Normals map by the inverse transpose of the linear part.
       p.normal = normalize(transformVector(transpose(inverse(m)), n));
     }

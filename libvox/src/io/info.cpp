@@ -93,13 +93,8 @@ Summary summarize(const InfoSource& in) {
 double sceneVolume(const Scene& sc) {
   double v = 0;
   for (const Triangle& t : sc.triangles) v += dot(t.v[0], cross(t.v[1], t.v[2])) / 6;
-  for (const Sphere& sp : sc.spheres) {
-    const auto& m = sp.transform.m;
-    const double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
-                       m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
-                       m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-    v += 4.0 / 3.0 * M_PI * sp.radius * sp.radius * sp.radius * std::fabs(det);
-  }
+  for (const Sphere& sp : sc.spheres)
+    v += 4.0 / 3.0 * M_PI * sp.radius * sp.radius * sp.radius * std::fabs(linearDeterminant(sp.transform));
   return v;
 }
 

@@ -253,15 +253,6 @@ struct SceneWinding {
   }
 };
 
-Vec3 cellCentre(const Grid& grid, uint64_t key) {
-  const auto ijk = cellIndex(grid.dims, key);
-  Vec3 q;
-  for (int a = 0; a < 3; ++a)
-    q.at(a) = 0.5 * (cellBoundary(grid.bounds, grid.dims, a, ijk[a]) +
-                     cellBoundary(grid.bounds, grid.dims, a, int64_t(ijk[a]) + 1));
-  return q;
-}
-
 // A solid part [lo, hi] of an empty run, x indices within its row; empty when lo > hi.
 struct Piece {
   uint32_t lo = 1, hi = 0;

@@ -79,6 +79,12 @@ inline double cellBoundary(const Box& bounds, const std::array<uint32_t, 3>& dim
   return bounds.lo[axis] + (bounds.hi[axis] - bounds.lo[axis]) * double(i) / double(dims[axis]);
 }
 Box cellBox(const Grid& grid, uint32_t i, uint32_t j, uint32_t k);
+// The centre of cell i on `axis`: the midpoint of its two boundaries, as every centre in libvox is computed.
+inline double cellCentreOnAxis(const Box& bounds, const std::array<uint32_t, 3>& dims, int axis, int64_t i) {
+  return 0.5 * (cellBoundary(bounds, dims, axis, i) + cellBoundary(bounds, dims, axis, i + 1));
+}
+// The centre of the cell with `key`.
+Vec3 cellCentre(const Grid& grid, uint64_t key);
 
 // Index of the occupied cell with `key`, or -1. O(log occupied).
 int64_t findCell(const Grid& grid, uint64_t key);

@@ -55,6 +55,7 @@ Mat4 operator*(const Mat4& a, const Mat4& b);
 Vec3 transformPoint(const Mat4& m, const Vec3& p);
 Vec3 transformVector(const Mat4& m, const Vec3& v);  // linear part only
 Mat4 inverse(const Mat4& m);                         // throws vox::Error when singular
+double linearDeterminant(const Mat4& m);             // of the upper-left 3x3 (linear) part
 Mat4 transpose(const Mat4& m);
 Mat4 translation(const Vec3& t);
 Mat4 scaling(const Vec3& s);

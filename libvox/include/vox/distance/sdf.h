@@ -34,12 +34,6 @@ struct SdfBand {
   std::vector<double> values;  // signed distance at each cell's centre
 };
 
-struct SdfReport {
-  uint64_t candidates = 0;     // (cell, primitive) distances evaluated within the band
-  uint64_t insideQueries = 0;  // inside tests at occupied cells' centres
-  uint64_t planesLeftOut = 0;  // planes of the scene, which have no distance here
-};
-
 // Which side of the solid a point is on: inside a sphere or an ellipsoid, or where the triangles' generalized
 // winding number has magnitude >= kWindingThreshold: the test `--fill` applies to its runs (fill.h), so a closed
 // surface decides exactly, an open or self-intersecting one as the fill does.
@@ -56,16 +50,12 @@ class InsideTest {
 // Check of a --sdf half-width: finite, > 0, <= kMaxSdfHalfWidth; throws UsageError naming `what` otherwise.
 void checkSdfHalfWidth(double halfWidth, const char* what);
 
-// The centre of cell (i, j, k): the midpoint of its boundaries (cellBoundary).
-Vec3 cellCentre(const Grid& grid, uint32_t i, uint32_t j, uint32_t k);
-
 // The band: every cell whose centre lies within halfWidth smallest cell edges of a bounded primitive, with its
 // signed distance. The sign of an empty cell is its fill status (precondition: grid.solidRuns as fillSolid set
 // them for this scene); an occupied cell's centre gets InsideTest. Work spread over the caller's TBB arena; the
 // result does not depend on the thread count. Throws UsageError for a bad half-width, LimitError past the memory
 // limit, vox::Error when cancelled.
-SdfBand signedDistanceBand(const Grid& grid, const Scene& scene, const SdfOptions& options = {},
-                           SdfReport* report = nullptr);
+SdfBand signedDistanceBand(const Grid& grid, const Scene& scene, const SdfOptions& options = {});
 
 // Options whose cells are exactly cubic, for distances: with a resolution and no bounds, the bounds grown about the
 // scene's (by less than a cell on each shorter axis) so that every cell has the longest axis' edge, as an OpenVDB

@@ -74,9 +74,41 @@ done
 [ $? = 1 ] && grep -q 'cubic cells' "$tmp/err" && [ ! -e "$tmp/flat.vdb" ] || fail "non-cubic level set: $(cat "$tmp/err")"
 "$build/vox-export" "$tmp/flat.vgrid" -o "$tmp/flat.npz" -q || fail "non-cubic .npz"
 
-# --fraction: refused before any work until the exact fractions exist.
-"$build/vox-voxelize" "$cube" -o "$tmp/f.vgrid" --res 8 --fraction 2>"$tmp/err"
-[ $? = 1 ] && [ ! -e "$tmp/f.vgrid" ] && grep -q 'fraction' "$tmp/err" || fail "--fraction: $(cat "$tmp/err")"
+# --fraction (implies --fill): a box of volume 0.34 * 0.5 * 0.62 whose faces cut cells, so most boundary fractions
+# are strictly between 0 and 1. vox-info's total, the .npz's fraction (1 on solid cells) times cell volumes, and the
+# .vdb's density grid all give the box's volume.
+printf 'v 0.13 0.21 0.05\nv 0.47 0.21 0.05\nv 0.47 0.71 0.05\nv 0.13 0.71 0.05\nv 0.13 0.21 0.67\nv 0.47 0.21 0.67\nv 0.47 0.71 0.67\nv 0.13 0.71 0.67\nf 1 4 3\nf 1 3 2\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n' >"$tmp/box.obj"
+"$build/vox-voxelize" "$tmp/box.obj" -o "$tmp/f.vgrid" --grid 7 9 8 --bounds 0 0 0 0.7 0.9 0.8 --fraction -q \
+  2>"$tmp/err" || fail "--fraction: $(cat "$tmp/err")"
+"$build/vox-info" "$tmp/f.vgrid" >"$tmp/info" || fail "vox-info --fraction"
+grep -Eq '^fraction_volume: 0\.105(4|39999)' "$tmp/info" || fail "vox-info: $(grep fraction "$tmp/info")"
+"$build/vox-export" "$tmp/f.vgrid" -o "$tmp/f.npz" -q || fail "export fractions .npz"
+"$build/vox-export" "$tmp/f.vgrid" -o "$tmp/f.vdb" -q || fail "export fractions .vdb"
+$py - "$tmp" <<'PY' || fail "fractions read back"
+import sys, numpy as np
+tmp = sys.argv[1]
+z = np.load(tmp + "/f.npz")
+f, solid, occ = z["fraction"], z["solid"], z["occupancy"]
+assert f.shape == (7, 9, 8), f.shape
+assert np.all((f >= 0) & (f <= 1)) and np.all(f[solid.astype(bool)] == 1)
+assert np.count_nonzero((f > 0) & (f < 1)) > 50, np.count_nonzero((f > 0) & (f < 1))
+exact = 0.34 * 0.5 * 0.62
+total = f.sum() * 0.1 ** 3
+assert abs(total - exact) < 1e-12 * exact, (total, exact)
+try:
+    import pyopenvdb as vdb
+except ImportError:
+    sys.exit(0)
+acc = vdb.read(tmp + "/f.vdb", "density").getConstAccessor()
+for (i, j, k) in np.argwhere(occ):
+    v, on = acc.probeValue((int(i), int(j), int(k)))
+    assert v == np.float32(f[i, j, k]), (i, j, k, v, f[i, j, k])
+PY
+# An open mesh has no exact volume: refused with one line, nothing written.
+head -n 18 "$tmp/box.obj" >"$tmp/open.obj"
+"$build/vox-voxelize" "$tmp/open.obj" -o "$tmp/open.vgrid" --res 8 --fraction 2>"$tmp/err"
+[ $? = 1 ] && [ ! -e "$tmp/open.vgrid" ] && grep -q 'open edges' "$tmp/err" && [ "$(wc -l <"$tmp/err")" = 1 ] ||
+  fail "--fraction of an open mesh: $(cat "$tmp/err")"
 
 # A scene with a plane: distances leave it out and say so.
 "$build/vox-voxelize" "$src/data/6837/scenes/scene2_06_plane.txt" -o "$tmp/p.vgrid" --res 8 --sdf 2>"$tmp/err" ||

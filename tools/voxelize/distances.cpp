@@ -8,13 +8,11 @@
 #include "vox/core/progress.h"
 #include "vox/core/tool.h"
 #include "vox/distance/sdf.h"
+#include "vox/volume/fractions.h"
 
 namespace vox::voxelize_tool {
 
 void checkDistanceFlags(const Options& opt) {
-  // Refused before any work until the exact volume fractions exist (issue 38); the grid file, vox-info and the
-  // exports already carry them.
-  if (opt.fraction) fail<UsageError>("--fraction: volume fractions are not available in this build yet");
   if (opt.sdf) checkSdfHalfWidth(*opt.sdf, "--sdf");
   if ((opt.sdf || opt.fraction) && !opt.bricks.empty())
     fail<UsageError>("--sdf and --fraction write a single grid file; grid sets (--bricks) hold no distances");
@@ -40,6 +38,17 @@ void addDistances(const Options& opt, const Scene& scene, uint64_t memoryLimitBy
       return true;
     };
     storeSignedDistances(grid, scene, so, opt.fill);
+    bar.finish();
+  }
+  if (opt.fraction) {
+    ProgressBar bar("fractions", opt.common.quiet);
+    FractionOptions fo;
+    fo.memoryLimitBytes = memoryLimitBytes;
+    fo.progress = [&](double f) {
+      bar.update(f);
+      return true;
+    };
+    grid.fractions = volumeFractions(grid, scene, fo);
     bar.finish();
   }
 }

@@ -8,8 +8,8 @@
 
 namespace vox::voxelize_tool {
 
-// Checks the flags before any work: --sdf's half-width, neither flag with --bricks (grid sets hold no distances),
-// and --fraction, refused until the volume fractions exist.
+// Checks the flags before any work: --sdf's half-width, and neither flag with --bricks (grid sets hold no
+// distances).
 // Throws UsageError.
 void checkDistanceFlags(const Options& opt);
 
@@ -19,7 +19,8 @@ void checkDistanceFlags(const Options& opt);
 VoxelizeOptions cubicCellsForDistances(const Options& opt, const Scene& scene, VoxelizeOptions vo);
 
 // With --sdf: stores the band in `grid` (storeSignedDistances; the fill runs on the side without --fill), with a
-// progress bar and a warning for planes.
+// progress bar and a warning for planes. With --fraction (which implies --fill): the occupied cells' volume
+// fractions (volumeFractions).
 void addDistances(const Options& opt, const Scene& scene, uint64_t memoryLimitBytes, Grid& grid);
 
 }  // namespace vox::voxelize_tool

@@ -13,6 +13,7 @@
 #include "vox/io/grid_file.h"
 #include "vox/io/grid_set.h"
 #include "vox/voxelize/fill.h"
+#include "vox/volume/fractions.h"
 
 namespace {
 
@@ -31,6 +32,7 @@ Grid voxelizeAndFill(const Options& opt, const Scene& scene, VoxelizeOptions vo,
     return true;
   };
   try {
+    if (opt.fraction) checkVolumeFractionsPossible(scene, vo.method, vo.memoryLimitBytes);  // before any work
     Grid grid = voxelizeScene(scene, vo, &stats);
     bar.finish();
     if (opt.fill) {
@@ -41,7 +43,7 @@ Grid voxelizeAndFill(const Options& opt, const Scene& scene, VoxelizeOptions vo,
         fillBar.update(f);
         return true;
       };
-      const FillReport report = fillSolid(grid, scene, fo);
+      const FillReport report = fillSolid(grid, scene, opt.fraction ? fillForFractions(fo) : fo);
       fillBar.finish();
       voxelize_tool::reportFill(opt, report);
     }

@@ -36,8 +36,9 @@ void addOptions(CLI::App& app, Options& opt) {
       ->expected(0, 1)
       ->type_name("[HALF]");
   app.add_flag("--fraction", opt.fraction,
-               "Also store each occupied cell's volume fraction inside the solid: exact for closed meshes and "
-               "spheres; open meshes and ellipsoids are refused");
+               "Also store each occupied cell's volume fraction inside the solid (implies --fill, whose solid cells "
+               "count 1): exact for closed meshes, balls to 1e-12 of a cell; open or self-overlapping meshes, "
+               "ellipsoids and planes are refused");
   app.add_option("--bricks", opt.bricks,
                  "Write a grid set: OUT is a manifest naming the scene file and one brick file per non-empty brick "
                  "of BX x BY x BZ bricks (in a new folder OUT_NAME.bricks/gHEX/ beside it; the old set is removed once "
@@ -59,7 +60,9 @@ std::optional<int> parseCommandLine(int argc, char** argv, Options& opt) {
   CLI::App app{"Voxelize a scene (.txt course format, .obj, .gltf, .glb, .ply) into a sparse grid file (.vgrid).",
                "vox-voxelize"};
   addOptions(app, opt);
-  return cli::parse(app, argc, argv);
+  const std::optional<int> exit = cli::parse(app, argc, argv);
+  opt.fill = opt.fill || opt.fraction;  // a fraction's cells inside are the fill's solid cells (DESIGN.md)
+  return exit;
 }
 
 }  // namespace vox::voxelize_tool

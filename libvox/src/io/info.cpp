@@ -7,6 +7,7 @@
 #include <functional>
 #include <sstream>
 
+#include "vox/core/compensated_sum.h"
 #include "vox/io/grid_set.h"
 
 namespace vox {
@@ -91,11 +92,11 @@ Summary summarize(const InfoSource& in) {
 // The solid's volume as the scene gives it: the triangles' signed volume (divergence theorem: sum of a . (b x c) / 6,
 // positive for outward-oriented closed meshes) plus each sphere's and ellipsoid's 4/3 pi r^3 |det L|.
 double sceneVolume(const Scene& sc) {
-  double v = 0;
-  for (const Triangle& t : sc.triangles) v += dot(t.v[0], cross(t.v[1], t.v[2])) / 6;
+  CompensatedSum v;
+  for (const Triangle& t : sc.triangles) v.add(dot(t.v[0], cross(t.v[1], t.v[2])) / 6);
   for (const Sphere& sp : sc.spheres)
-    v += 4.0 / 3.0 * M_PI * sp.radius * sp.radius * sp.radius * std::fabs(linearDeterminant(sp.transform));
-  return v;
+    v.add(4.0 / 3.0 * M_PI * sp.radius * sp.radius * sp.radius * std::fabs(linearDeterminant(sp.transform)));
+  return v.value();
 }
 
 // What --sdf and --fraction stored: the band's size and range; the fractions' volume beside the scene's own.
@@ -113,9 +114,10 @@ DistanceSummary summarizeDistances(const Scene& sc, const Grid& g, uint64_t soli
   if (!g.fractions.empty()) {
     double cell = 1;
     for (int a = 0; a < 3; ++a) cell *= (g.bounds.hi[a] - g.bounds.lo[a]) / g.dims[a];
-    double sum = double(solidCells);
-    for (double f : g.fractions) sum += f;
-    d.fractionVolume = sum * cell;
+    CompensatedSum sum;
+    sum.add(double(solidCells));
+    for (double f : g.fractions) sum.add(f);
+    d.fractionVolume = sum.value() * cell;
     d.sceneVolume = sceneVolume(sc);
   }
   return d;

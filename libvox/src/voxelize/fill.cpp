@@ -817,6 +817,7 @@ std::string describeFill(const FillReport& r) {
   if (r.openEdges > 0) out << "mesh has " << r.openEdges << " open edges";
   if (r.openEdges > 0 && r.leakyMethod) out << "; ";
   if (r.leakyMethod) out << "method center leaves gaps in surfaces";
+  if (r.openEdges == 0 && !r.leakyMethod) out << "asked for: closed cavities stay empty";
   out << "), " << r.solidCells << " solid cells (" << r.enclosedCells << " enclosed, " << r.windingCells
       << " by winding number, " << r.windingQueries << " evaluations";
   if (r.capQueries > 0) out << ", " << r.capQueries << " of the hole caps alone";

@@ -1,0 +1,55 @@
+// The bounded primitive nearest to any point (DESIGN.md "Distance and volume": Grid.distance, libvox.sdf): a
+// bounding volume hierarchy over the scene's triangles, spheres and ellipsoids (planes are left out), queried depth
+// first, nearer child first, pruned by the squared distance to a node's box. Distances are the ones the --sdf band
+// uses (squaredDistanceToTriangle, closestPointOnEllipsoid), so a dense field equals the band bit for bit.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "vox/core/math.h"
+#include "vox/core/scene.h"
+#include "vox/distance/closest_point.h"
+
+namespace vox {
+
+struct NearestHit {
+  double squaredDistance = INFINITY;
+  int64_t primitive = -1;  // the grid's ids: triangles, then spheres; -1 when nothing is within the bound
+};
+
+class NearestPrimitive {
+ public:
+  // Copies what it needs from `scene` (about 150 bytes per primitive). Throws InputError for a singular sphere
+  // transform (ellipsoidShape).
+  explicit NearestPrimitive(const Scene& scene);
+
+  // The primitive nearest to p, ties to the lowest id. `bound2`: a squared distance the caller knows the answer does
+  // not exceed (a neighbour's distance plus their separation, rounded up), which prunes the search; subtrees and
+  // primitives farther than it are skipped, so a bound below the true distance gives primitive -1.
+  NearestHit nearest(const Vec3& p, double bound2 = INFINITY) const;
+
+  // The point of primitive `id` nearest to p.
+  Vec3 closestPoint(int64_t id, const Vec3& p) const;
+
+  size_t primitiveCount() const { return ids_.size(); }
+
+ private:
+  struct Node {
+    Box box;
+    uint32_t first = 0;  // leaf: its first primitive slot; inner: the second child (the first is the next node)
+    uint32_t count = 0;  // primitives of a leaf; 0 for an inner node
+  };
+  double squaredDistanceTo(uint32_t slot, const Vec3& p, double bound2) const;
+  uint32_t build(uint32_t begin, uint32_t end, std::vector<Vec3>& centroids, std::vector<Box>& boxes);
+
+  std::vector<Node> nodes_;
+  std::vector<uint32_t> ids_;           // slot -> primitive id, in leaf order
+  std::vector<uint32_t> slotOf_;        // primitive id -> slot
+  std::vector<Triangle> triangles_;     // by slot (unused slots of spheres hold nothing useful)
+  std::vector<Vec3> normals_;           // by slot: (b - a) x (c - a) of triangles
+  std::vector<EllipsoidShape> shapes_;  // by sphere index
+  uint32_t triangleCount_ = 0;
+};
+
+}  // namespace vox

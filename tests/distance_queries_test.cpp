@@ -1,0 +1,144 @@
+// Distances beyond the band: NearestPrimitive against brute force over every primitive (bit for bit, ties to the
+// lowest id), the dense field against the --sdf band and brute force, either memory layout, and point queries with
+// their closest points, NaN refused, cancellation.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "test_util.h"
+#include "vox/core/error.h"
+#include "vox/distance/nearest.h"
+#include "vox/distance/queries.h"
+#include "vox/distance/sdf.h"
+#include "vox/import/import.h"
+#include "vox/voxelize/fill.h"
+#include "vox/voxelize/voxelize.h"
+
+namespace vox {
+namespace {
+
+// The bunny of 1k triangles, a ball and an ellipsoid beside it.
+Scene dqScene() {
+  Scene s = importObj(testing::seed("6837/scenes/bunny_1k.obj"));
+  const Box b = *sceneBounds(s);
+  Sphere ball;
+  ball.center = b.hi + Vec3{0.1, 0, 0};
+  ball.radius = 0.05;
+  s.spheres.push_back(ball);
+  Sphere ell = ball;
+  ell.center = b.lo - Vec3{0.1, 0, 0};
+  ell.transform = translation(ell.center) * scaling({1.5, 1, 0.7}) * translation(ell.center * -1.0);
+  s.spheres.push_back(ell);
+  return s;
+}
+
+double dqBruteDistance2(const Scene& s, const std::vector<EllipsoidShape>& shapes, const Vec3& p, int64_t* id) {
+  double best = INFINITY;
+  *id = -1;
+  for (size_t t = 0; t < s.triangles.size(); ++t) {
+    const Triangle& tr = s.triangles[t];
+    const double d2 = squaredDistanceToTriangle(tr.v[0], tr.v[1], tr.v[2], p);
+    if (d2 < best) best = d2, *id = int64_t(t);
+  }
+  for (size_t e = 0; e < shapes.size(); ++e) {
+    const Vec3 d = p - closestPointOnEllipsoid(shapes[e], p);
+    if (dot(d, d) < best) best = dot(d, d), *id = int64_t(s.triangles.size() + e);
+  }
+  return best;
+}
+
+TEST(NearestPrimitive, EqualsBruteForceBitForBit) {
+  const Scene s = dqScene();
+  std::vector<EllipsoidShape> shapes;
+  for (const Sphere& sp : s.spheres) shapes.push_back(ellipsoidShape(sp));
+  const NearestPrimitive nearest(s);
+  const Box b = *sceneBounds(s);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-0.5, 1.5);
+  for (int n = 0; n < 3000; ++n) {
+    Vec3 p;
+    for (int a = 0; a < 3; ++a) p.at(a) = b.lo[a] + u(rng) * (b.hi[a] - b.lo[a]);
+    if (n % 3 == 0) p = s.triangles[size_t(n) % s.triangles.size()].v[n % 3];  // on a vertex
+    int64_t id;
+    const double want = dqBruteDistance2(s, shapes, p, &id);
+    const NearestHit hit = nearest.nearest(p);
+    ASSERT_EQ(hit.squaredDistance, want) << n;
+    if (want > 0) {
+      EXPECT_EQ(hit.primitive, id) << n;
+    }
+    // A bound at the answer keeps it; one below gives nothing.
+    EXPECT_EQ(nearest.nearest(p, want).squaredDistance, want);
+    if (want > 0) {
+      EXPECT_EQ(nearest.nearest(p, want * 0.999).primitive, -1);
+    }
+  }
+  EXPECT_EQ(NearestPrimitive(Scene{}).nearest({0, 0, 0}).primitive, -1);
+}
+
+Grid dqFilledGrid(const Scene& s, std::array<uint32_t, 3> dims) {
+  VoxelizeOptions o;
+  o.dims = dims;
+  Grid g = voxelizeScene(s, o);
+  fillSolid(g, s);
+  return g;
+}
+
+TEST(DenseSignedDistances, EqualTheBandAndBruteForceInEitherLayout) {
+  const Scene s = dqScene();
+  std::vector<EllipsoidShape> shapes;
+  for (const Sphere& sp : s.spheres) shapes.push_back(ellipsoidShape(sp));
+  const Grid g = dqFilledGrid(s, {19, 14, 17});
+  const auto [nx, ny, nz] = g.dims;
+  std::vector<double> c(g.cellCount()), f(g.cellCount());
+  denseSignedDistances(g, s, c, {uint64_t(ny) * nz, nz, 1});  // numpy's C order
+  denseSignedDistances(g, s, f, {1, nx, uint64_t(nx) * ny});  // key order
+  for (uint64_t key = 0; key < g.cellCount(); ++key) {
+    const auto ijk = cellIndex(g.dims, key);
+    const double value = c[(uint64_t(ijk[0]) * ny + ijk[1]) * nz + ijk[2]];
+    ASSERT_EQ(value, f[key]) << key;
+    int64_t id;
+    ASSERT_EQ(std::fabs(value), std::sqrt(dqBruteDistance2(s, shapes, cellCentre(g, key), &id))) << key;
+  }
+  SdfOptions o;
+  o.halfWidth = 2.5;
+  const SdfBand band = signedDistanceBand(g, s, o);
+  ASSERT_FALSE(band.keys.empty());
+  for (size_t b = 0; b < band.keys.size(); ++b) EXPECT_EQ(f[band.keys[b]], band.values[b]) << band.keys[b];
+  size_t negative = 0;
+  for (double v : f) negative += v < 0;
+  EXPECT_GT(negative, 0u);
+}
+
+TEST(PointDistances, SignedUnsignedClosestPointsNaNAndCancel) {
+  const Scene s = dqScene();
+  const Box b = *sceneBounds(s);
+  const Vec3 mid = (b.lo + b.hi) * 0.5;
+  const std::vector<double> pts = {mid.x, mid.y, mid.z, b.hi.x + 1, b.hi.y, b.hi.z, b.lo.x - 0.1, b.lo.y, b.lo.z};
+  std::vector<double> d(3), ud(3), closest(9);
+  std::vector<int64_t> prim(3);
+  pointDistances(s, pts, true, {d, prim, closest});
+  pointDistances(s, pts, false, {ud, prim, closest});
+  const NearestPrimitive nearest(s);
+  for (size_t i = 0; i < 3; ++i) {
+    const Vec3 p{pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]};
+    const NearestHit hit = nearest.nearest(p);
+    EXPECT_EQ(prim[i], hit.primitive);
+    EXPECT_EQ(ud[i], std::sqrt(hit.squaredDistance));
+    EXPECT_EQ(std::fabs(d[i]), ud[i]);
+    const Vec3 q{closest[3 * i], closest[3 * i + 1], closest[3 * i + 2]};
+    EXPECT_NEAR(length(p - q), ud[i], 1e-12 * (1 + ud[i]));
+  }
+  EXPECT_LT(d[0], 0);  // the bunny's middle is inside
+  EXPECT_GT(d[1], 0);
+  std::vector<double> bad = pts;
+  bad[4] = NAN;
+  EXPECT_THROW(pointDistances(s, bad, false, {d, prim, closest}), InputError);
+  DistanceQueryOptions cancel;
+  cancel.progress = [](double) { return false; };
+  EXPECT_THROW(pointDistances(s, pts, false, {d, prim, closest}, cancel), Error);
+}
+
+}  // namespace
+}  // namespace vox

@@ -22,6 +22,7 @@ from ._libvox import (
     load,
     render,
     save_image,
+    sdf,
     voxelize,
     voxelize_batch,
 )
@@ -34,6 +35,7 @@ __all__ = [
     "load",
     "render",
     "save_image",
+    "sdf",
     "voxelize",
     "voxelize_batch",
 ]

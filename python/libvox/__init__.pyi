@@ -41,12 +41,17 @@ class Grid:
     @property
     def indices(self) -> npt.NDArray[np.int32]: ...
     @property
+    def fractions(self) -> npt.NDArray[np.float64]: ...
+    @property
     def sdf(self) -> Tuple[npt.NDArray[np.int32], npt.NDArray[np.float64]]: ...
     @property
     def sdf_half_width(self) -> float: ...
     @property
     def solid_indices(self) -> npt.NDArray[np.int32]: ...
     def dense(self, solid: bool = True) -> npt.NDArray[np.bool_]: ...
+    def distance(
+        self, points: _Array, signed: bool = True, threads: Optional[_Int] = None
+    ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64], npt.NDArray[np.float64]]: ...
     @property
     def points(self) -> npt.NDArray[np.float64]: ...
     @property
@@ -101,9 +106,20 @@ def voxelize(
     method: str = "exact",
     fill: Optional[bool] = None,
     sdf: Optional[_Float] = None,
+    fraction: bool = False,
     threads: Optional[_Int] = None,
     progress: _Progress = False,
 ) -> Grid: ...
+def sdf(
+    source: _Source,
+    *,
+    resolution: Optional[_Int] = None,
+    dims: Union[None, _Int, Sequence[_Int]] = None,
+    pitch: Union[None, _Float, Sequence[_Float]] = None,
+    bounds: Optional[_Array] = None,
+    threads: Optional[_Int] = None,
+    progress: _Progress = False,
+) -> npt.NDArray[np.float64]: ...
 def voxelize_batch(
     sources: Iterable[_Source],
     resolution: _Int = 64,

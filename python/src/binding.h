@@ -172,5 +172,6 @@ void bindRays(GridClass& grid);
 void bindRender(py::module_& m);
 void bindMesh(GridClass& grid);
 void bindBench(py::module_& m);
+void bindDistance(GridClass& grid);
 
 }  // namespace voxpy

@@ -1,4 +1,5 @@
 // libvox.Grid and libvox.load: a grid and its scene, read as numpy arrays (DESIGN.md "Python", "Grid").
+#include <algorithm>
 #include <sstream>
 
 #include "binding.h"
@@ -56,6 +57,15 @@ py::tuple sdfBand(PyGrid& self) {
     }
   }
   return py::make_tuple(indices, values);
+}
+
+// The --fraction values: (N,) float64 in the order of `indices`; an empty array without them.
+py::array_t<double> fractions(PyGrid& self) {
+  const Grid& g = self.grid();
+  checkArray(self, double(g.fractions.size()) * 8, "fractions");
+  py::array_t<double> out{py::ssize_t(g.fractions.size())};
+  std::copy(g.fractions.begin(), g.fractions.end(), out.mutable_data());
+  return out;
 }
 
 py::array_t<int32_t> solidIndices(PyGrid& self) {
@@ -262,6 +272,10 @@ Arrays returned by properties are computed on each access unless noted (keep the
       .def_property_readonly(
           "indices", [](const PyGrid& s) { return indicesOf(s.grid(), s.grid().cellKeys); },
           "Occupied cells, (N, 3) int32 [i, j, k], in the file's order (ascending key i + nx (j + ny k)).")
+      .def_property_readonly("fractions", &fractions,
+                             "The volume fractions of voxelize(..., fraction=True): (N,) float64 in [0, 1], the part "
+                             "of each occupied cell (the order of indices) inside the solid; solid cells count 1. "
+                             "Empty without them.")
       .def_property_readonly("sdf", &sdfBand,
                              "The signed distance band of voxelize(..., sdf=HALF): (indices (B, 3) int32 [i, j, k], "
                              "ascending key; values (B,) float64, negative inside). Empty arrays without one.")

@@ -10,6 +10,7 @@ PYBIND11_MODULE(_libvox, m) {
   voxpy::bindSave(grid);
   voxpy::bindMesh(grid);
   voxpy::bindRays(grid);
+  voxpy::bindDistance(grid);
   voxpy::bindVoxelize(m);
   voxpy::bindRender(m);
   voxpy::bindBench(m);

@@ -9,7 +9,10 @@
 #include "vox/export/voxel_runs.h"
 #include "vox/import/import.h"
 #include "vox/io/input_file.h"
+#include "vox/core/memory_budget.h"
+#include "vox/distance/queries.h"
 #include "vox/distance/sdf.h"
+#include "vox/volume/fractions.h"
 #include "vox/voxelize/fill.h"
 #include "vox/voxelize/voxelize.h"
 
@@ -144,50 +147,73 @@ vox::Vec3 pitchArg(const py::object& pitch) {
   return size;
 }
 
-std::shared_ptr<PyGrid> voxelize(const py::object& source, const py::object& resolution, const py::object& dims,
-                                 const py::object& pitch, const py::object& bounds, const py::object& method,
-                                 const py::object& fill, const py::object& sdf, const py::object& threads,
-                                 const py::object& progress) {
-  Source src = sourceArg(source, "source", "");
-  vox::VoxelizeOptions vo;
+// The grid a call asks for: at most one of resolution, dims and pitch, bounds, and the method.
+struct GridRequest {
+  vox::VoxelizeOptions options;
+  std::optional<Pitch> pitch;  // applied once the scene is loaded (applyPitch)
+};
+
+GridRequest gridRequest(const py::object& resolution, const py::object& dims, const py::object& pitch,
+                        const py::object& bounds, const py::object& method) {
+  GridRequest r;
+  vox::VoxelizeOptions& vo = r.options;
   vo.method = enumArg(method, "method", vox::parseMethod);
   const int given = int(!resolution.is_none()) + int(!dims.is_none()) + int(!pitch.is_none());
   if (given > 1) vox::fail<vox::UsageError>("give at most one of resolution, dims and pitch");
   if (!resolution.is_none()) vo.resolution = uint32_t(intArg(resolution, "resolution", 1, vox::kMaxCellsPerAxis));
   if (!dims.is_none()) vo.dims = dims3Arg(dims, "dims", vox::kMaxCellsPerAxis);
   if (!bounds.is_none()) vo.bounds = boxArg(bounds, "bounds");
-  std::optional<Pitch> pitchSize;
-  if (!pitch.is_none()) pitchSize = Pitch{pitchArg(pitch)};
-  const bool doFill = fillArg(fill);
+  if (!pitch.is_none()) r.pitch = Pitch{pitchArg(pitch)};
+  vo.memoryLimitBytes = memoryBudget();
+  return r;
+}
+
+std::shared_ptr<PyGrid> voxelize(const py::object& source, const py::object& resolution, const py::object& dims,
+                                 const py::object& pitch, const py::object& bounds, const py::object& method,
+                                 const py::object& fill, const py::object& sdf, const py::object& fraction,
+                                 const py::object& threads, const py::object& progress) {
+  Source src = sourceArg(source, "source", "");
+  GridRequest request = gridRequest(resolution, dims, pitch, bounds, method);
+  vox::VoxelizeOptions& vo = request.options;
+  const bool doFractions = boolArg(fraction, "fraction", true);
+  const bool doFill = fillArg(fill) || doFractions;  // a fraction's cells inside are the fill's solid cells
   std::optional<double> sdfHalfWidth;
   if (!sdf.is_none()) {
     sdfHalfWidth = floatArg(sdf, "sdf");
     vox::checkSdfHalfWidth(*sdfHalfWidth, "sdf");
   }
   const auto nThreads = threadsArg(threads);
-  vo.memoryLimitBytes = memoryBudget();
   Interrupt interrupt(progressCallable(progress, "voxelizing"));
-  const double voxelizeShare = sdfHalfWidth ? 0.3 : (doFill ? 0.7 : 1.0);
+  const double voxelizeShare = sdfHalfWidth || doFractions ? 0.3 : (doFill ? 0.7 : 1.0);
+  const double sdfEnd = doFractions ? 0.6 : 1.0;
   vo.progress = [&](double f) { return interrupt.poll(voxelizeShare * f); };
   vox::FillReport report;
   vox::Grid grid = runLong(interrupt, nThreads, [&] {
     const vox::Scene& scene = src.load();
-    if (pitchSize) applyPitch(*pitchSize, scene, vo);
+    if (request.pitch) applyPitch(*request.pitch, scene, vo);
     return namedAfter(src, [&] {
       if (sdfHalfWidth) vo = vox::withCubicCells(scene, vo);  // as vox-voxelize --sdf: a level set's cubic cells
+      if (doFractions) vox::checkVolumeFractionsPossible(scene, vo.method, vo.memoryLimitBytes);
       vox::Grid g = vox::voxelizeScene(scene, vo);
       if (doFill) {
         vox::FillOptions fo;
         fo.memoryLimitBytes = vo.memoryLimitBytes;
-        fo.progress = [&](double f) { return interrupt.poll(0.7 + 0.3 * f); };
-        report = vox::fillSolid(g, scene, fo);
+        fo.progress = [&](double f) { return interrupt.poll(voxelizeShare + (1 - voxelizeShare) * f); };
+        report = vox::fillSolid(g, scene, doFractions ? vox::fillForFractions(fo) : fo);
       }
       if (sdfHalfWidth) {
         vox::SdfOptions so;
         so.halfWidth = *sdfHalfWidth;
         so.memoryLimitBytes = vo.memoryLimitBytes;
-        so.progress = [&](double f) { return interrupt.poll(0.3 + 0.7 * f); };
+        so.progress = [&](double f) { return interrupt.poll(0.3 + (sdfEnd - 0.3) * f); };
         vox::storeSignedDistances(g, scene, so, doFill);
+      }
+      if (doFractions) {
+        vox::FractionOptions fo;
+        fo.memoryLimitBytes = vo.memoryLimitBytes;
+        const double start = sdfHalfWidth ? sdfEnd : 0.3;
+        fo.progress = [&](double f) { return interrupt.poll(start + (1 - start) * f); };
+        g.fractions = vox::volumeFractions(g, scene, fo);
       }
       return g;
     });
@@ -198,6 +224,44 @@ std::shared_ptr<PyGrid> voxelize(const py::object& source, const py::object& res
   if (doFill)
     if (const std::string w = vox::fillWarning(report); !w.empty()) warn(src.describe("fill: " + w));
   return std::make_shared<PyGrid>(vox::GridFile{std::move(src.scene), std::move(grid)}, src.name);
+}
+
+// libvox.sdf: the signed distance at every cell centre of the grid voxelize(source, ..., sdf=HALF) makes (cubic
+// cells with a resolution), as a C-ordered (nx, ny, nz) float64 array; the grid's band values equal it where both
+// exist.
+py::array_t<double> denseSdf(const py::object& source, const py::object& resolution, const py::object& dims,
+                             const py::object& pitch, const py::object& bounds, const py::object& threads,
+                             const py::object& progress) {
+  Source src = sourceArg(source, "source", "");
+  GridRequest request = gridRequest(resolution, dims, pitch, bounds, py::str("exact"));
+  vox::VoxelizeOptions& vo = request.options;
+  const auto nThreads = threadsArg(threads);
+  Interrupt interrupt(progressCallable(progress, "distances"));
+  vo.progress = [&](double f) { return interrupt.poll(0.2 * f); };
+  std::array<uint32_t, 3> gridDims{};
+  std::vector<double> field = runLong(interrupt, nThreads, [&] {
+    const vox::Scene& scene = src.load();
+    if (request.pitch) applyPitch(*request.pitch, scene, vo);
+    return namedAfter(src, [&] {
+      vo = vox::withCubicCells(scene, vo);
+      vox::Grid g = vox::voxelizeScene(scene, vo);
+      vox::FillOptions fo;
+      fo.memoryLimitBytes = vo.memoryLimitBytes;
+      fo.progress = [&](double f) { return interrupt.poll(0.2 + 0.2 * f); };
+      vox::fillSolid(g, scene, fo);
+      vox::checkMemory(double(g.cellCount()) * 8, src.name, "sdf()");
+      std::vector<double> out(g.cellCount());
+      const auto [nx, ny, nz] = g.dims;
+      vox::DistanceQueryOptions qo;
+      qo.progress = [&](double f) { return interrupt.poll(0.4 + 0.6 * f); };
+      vox::denseSignedDistances(g, scene, out, {uint64_t(ny) * nz, nz, 1}, qo);
+      gridDims = g.dims;
+      return out;
+    });
+  });
+  if (!src.scene.planes.empty())
+    warn(src.describe(std::to_string(src.scene.planes.size()) + " planes are left out of the signed distances"));
+  return adoptVector<double>(std::move(field), {gridDims[0], gridDims[1], gridDims[2]});
 }
 
 // The cube of `resolution` cells a side that voxelize_batch gives a mesh: its longest axis exactly, the others
@@ -321,7 +385,7 @@ void bindVoxelize(py::module_& m) {
   m.def("voxelize", &voxelize, py::arg("source"), py::kw_only(), py::arg("resolution") = py::none(),
         py::arg("dims") = py::none(), py::arg("pitch") = py::none(), py::arg("bounds") = py::none(),
         py::arg("method") = "exact", py::arg("fill") = py::none(), py::arg("sdf") = py::none(),
-        py::arg("threads") = py::none(), py::arg("progress") = false, R"doc(
+        py::arg("fraction") = false, py::arg("threads") = py::none(), py::arg("progress") = false, R"doc(
 Puts every triangle and sphere of a scene into the closed cells it meets, as `vox-voxelize` does (the same cells and
 primitive ids).
 
@@ -338,12 +402,28 @@ method: 'exact' (CGAL exact predicates, default), 'sat', 'bbox' or 'center'.
 fill: True also marks the empty cells inside closed surfaces as solid (generalized winding number for open meshes).
 sdf: a half-width HALF in (0, 64] cell widths: also the signed distance at the centre of every cell within HALF
     smallest cell edges of the surface (vox-voxelize --sdf; Grid.sdf; docs/distance.md).
+fraction: True also stores each occupied cell's volume fraction inside the solid (vox-voxelize --fraction;
+    Grid.fractions; implies fill, by winding number so that closed cavities stay empty): exact for closed meshes,
+    balls to 1e-12 of a cell; open or self-overlapping meshes, ellipsoids and planes raise UsageError.
 threads: worker threads (default: all cores).
 progress: True for a tqdm bar (when tqdm is installed), or a callable taking the fraction done.
 
 The GIL is released while it works; Ctrl-C raises KeyboardInterrupt within a fraction of a second.
 Raises InputError (bad file, with the file and place; bad arrays), UsageError (bad options), LimitError (the grid
 would not fit in memory, checked before allocating), TypeError (wrong argument types).
+)doc");
+
+  m.def("sdf", &denseSdf, py::arg("source"), py::kw_only(), py::arg("resolution") = py::none(),
+        py::arg("dims") = py::none(), py::arg("pitch") = py::none(), py::arg("bounds") = py::none(),
+        py::arg("threads") = py::none(), py::arg("progress") = false, R"doc(
+The signed distance at the centre of every cell, as a dense (nx, ny, nz) float64 array indexed [i, j, k]: the
+Euclidean distance (world units) to the nearest triangle, sphere or ellipsoid (planes are left out, with a
+warning), negative inside as fill decides it (closed surfaces exactly, open meshes by the winding number).
+
+The grid is the one voxelize(source, resolution=..., dims=..., pitch=..., bounds=..., sdf=HALF) makes (with a
+resolution, cells exactly cubic), so Grid.sdf's band values equal this array's at the band's indices bit for bit,
+and that grid's bounds and dims place the cells. source, resolution, dims, pitch, bounds, threads and progress as
+for voxelize. The whole array must fit in memory (checked before allocating: LimitError).
 )doc");
 
   m.def("voxelize_batch", &voxelizeBatch, py::arg("sources"), py::arg("resolution") = 64, py::kw_only(),

@@ -216,8 +216,14 @@ def _calls():
     g = "g"
     rays = dict(origins=[[0.2, 0.2, 5]], directions=[[0, 0, -1]])
     calls = [("voxelize source", ("source", "vertices", "faces"), lambda x, g, t: libvox.voxelize(x, resolution=4))]
-    for kw in ("resolution", "dims", "pitch", "bounds", "method", "fill", "sdf", "threads", "progress"):
+    for kw in ("resolution", "dims", "pitch", "bounds", "method", "fill", "sdf", "fraction", "threads", "progress"):
         calls.append((f"voxelize {kw}", (kw,), lambda x, g, t, kw=kw: libvox.voxelize((V, F), **{kw: x})))
+    calls.append(("sdf source", ("source", "vertices", "faces"), lambda x, g, t: libvox.sdf(x, resolution=4)))
+    for kw in ("resolution", "dims", "pitch", "bounds", "threads", "progress"):
+        calls.append((f"sdf {kw}", (kw,), lambda x, g, t, kw=kw: libvox.sdf((V, F), **{kw: x})))
+    for kw in ("points", "signed", "threads"):
+        calls.append((f"distance {kw}", (kw,),
+                      lambda x, g, t, kw=kw: g.distance(**{"points": [[0, 0, 0]], kw: x})))
     calls.append(("voxelize_batch sources", ("sources",), lambda x, g, t: libvox.voxelize_batch(x, 4)))
     calls.append(("voxelize_batch resolution", ("resolution",), lambda x, g, t: libvox.voxelize_batch([(V, F)], x)))
     for kw in ("fill", "method", "threads", "dense", "progress"):

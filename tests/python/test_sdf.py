@@ -48,3 +48,51 @@ def test_bad_half_widths_are_usage_errors(bad):
 def test_wrong_types_are_type_errors(bad):
     with pytest.raises(TypeError, match="sdf"):
         libvox.voxelize(CUBE, resolution=4, sdf=bad)
+
+
+def test_dense_sdf_equals_the_band_and_grid_distance():
+    """libvox.sdf on voxelize(sdf=)'s grid: the band's values at its indices bit for bit, Grid.distance at the cell
+    centres too, and both signs inside the cube."""
+    box = ((-0.4, -0.3, -0.2), (1.5, 1.4, 1.3))
+    field = libvox.sdf(CUBE, dims=(11, 9, 8), bounds=box)
+    g = libvox.voxelize(CUBE, dims=(11, 9, 8), bounds=box, sdf=3)
+    assert field.dtype == np.float64 and field.shape == tuple(g.dims)
+    indices, values = g.sdf
+    assert np.array_equal(field[tuple(indices.T)], values)
+    lo, hi = np.array(g.bounds[0]), np.array(g.bounds[1])
+    ijk = np.indices(field.shape).reshape(3, -1).T
+    b = lo[None, :] + (hi - lo)[None, :] * ijk / np.array(g.dims)
+    b1 = lo[None, :] + (hi - lo)[None, :] * (ijk + 1) / np.array(g.dims)
+    centres = 0.5 * (b + b1)  # as libvox computes a centre: the midpoint of the cell's two boundaries
+    d, prim, closest = g.distance(centres)
+    assert np.array_equal(d, field.reshape(-1))  # a closed cube: the fill's sign is the winding number's
+    assert d.dtype == np.float64 and prim.dtype == np.int64 and closest.shape == (len(d), 3)
+    assert np.all((prim >= 0) & (prim < 12))
+    assert np.allclose(np.linalg.norm(centres - closest, axis=1), np.abs(d), rtol=0, atol=1e-12)
+    assert (field < 0).any() and (field > 0).any()
+
+
+def test_grid_distance_signed_unsigned_and_bad_points():
+    g = libvox.voxelize(CUBE, resolution=4)
+    d, prim, closest = g.distance([[0.5, 0.5, 0.5], [2, 0.5, 0.5], [0.5, 0.5, 1]])
+    assert np.allclose(d, [-0.5, 1, 0], atol=1e-15) and d[2] == 0
+    assert np.allclose(closest[1], [1, 0.5, 0.5])
+    u, _, _ = g.distance(np.array([[0.5, 0.5, 0.5]], dtype=np.float32), signed=False)
+    assert u[0] == 0.5
+    e = g.distance(np.zeros((0, 3)))
+    assert e[0].shape == (0,) and e[1].shape == (0,) and e[2].shape == (0, 3)
+    with pytest.raises(libvox.InputError, match="points"):
+        g.distance([[0, 0, float("nan")]])
+    with pytest.raises(libvox.InputError, match="points"):
+        g.distance([[0, 0]])
+    with pytest.raises(TypeError, match="points"):
+        g.distance("points")
+    with pytest.raises(TypeError, match="signed"):
+        g.distance([[0, 0, 0]], signed="yes")
+
+
+def test_dense_sdf_refuses_bad_grids():
+    with pytest.raises(libvox.UsageError, match="resolution"):
+        libvox.sdf(CUBE, resolution=0)
+    with pytest.raises(libvox.UsageError, match="at most one"):
+        libvox.sdf(CUBE, resolution=4, dims=4)

@@ -828,7 +828,9 @@ std::string describeFill(const FillReport& r) {
 std::string fillWarning(const FillReport& r) {
   // Under the flood fill a full grid is exact (a closed box on the grid's faces); under the winding number it more
   // likely means an inside-out or wrapping surface.
-  if (r.rule == FillRule::WindingNumber && r.emptyCells > 0 && r.solidCells == r.emptyCells)
+  // A closed mesh filled by winding number on request (--fraction) is as exact as the flood fill.
+  const bool closed = r.openEdges == 0 && !r.leakyMethod;
+  if (r.rule == FillRule::WindingNumber && !closed && r.emptyCells > 0 && r.solidCells == r.emptyCells)
     return "every empty cell of the grid is solid (by winding number): is the grid inside the surface?";
   if (r.emptyCells > 0 && r.solidCells == 0) return "no empty cell is inside a surface: nothing filled";
   return "";

@@ -68,6 +68,14 @@ double gaussPiece(const BallBoxSection& s, double a, double b, const GaussRule& 
   return sum * 0.25 * std::numbers::pi * (b - a);
 }
 
+// The Gauss rules' agreement asked of a piece, relative to the cell's volume. The section's area is computed at the
+// ball's scale and loses about two digits where the cell is small against the ball (an arc's integral minus a
+// rectangle's), so differences below about 1e-14 of the cell are rounding, not quadrature error: a tolerance there
+// never converges and the bisection runs to its depth limit (14.8 s for a ball at 128^3 with 1e-15 and depth 30;
+// docs/distance.md). 1e-13 stays ten times below the 1e-12 the fractions promise.
+constexpr double kPieceTolerance = 1e-13;
+constexpr int kMaxDepth = 16;
+
 double adaptivePiece(const BallBoxSection& s, double a, double b, double tolerance, int depth) {
   static const GaussRule coarse(20), fine(40);
   const double i1 = gaussPiece(s, a, b, coarse), i2 = gaussPiece(s, a, b, fine);
@@ -128,7 +136,7 @@ double ballBoxVolume(const Vec3& center, double radius, const Box& box) {
   const double boxVolume = (box.hi.x - box.lo.x) * (box.hi.y - box.lo.y) * (box.hi.z - box.lo.z);
   double volume = 0;
   for (size_t i = 0; i + 1 < cuts.size(); ++i)
-    if (cuts[i] < cuts[i + 1]) volume += adaptivePiece(s, cuts[i], cuts[i + 1], 1e-15 * boxVolume, 30);
+    if (cuts[i] < cuts[i + 1]) volume += adaptivePiece(s, cuts[i], cuts[i + 1], kPieceTolerance * boxVolume, kMaxDepth);
   return volume;
 }
 

@@ -127,6 +127,9 @@ out.append("Measured by `bench/tradeoff.sh` (build with `-DVOX_BENCH=ON`), on th
            "process, no file I/O); trace times are of a shaded image (primary and shadow rays) through the grid. "
            "`added`/`missed` count (cell, primitive) references relative to `exact`; `px diff` counts pixels of the "
            "shaded image that differ from the brute-force image (no grid).\n")
+out.append("The volume each method's cells add up to, against the exact volume fractions: "
+           "[volume-error.md](volume-error.md). The distance error of OpenVDB's level set against libvox's exact "
+           "signed distances: [distance.md](distance.md), \"Cost, and OpenVDB's level set on the same voxels\".\n")
 if plots:
     out.append("Both plots are redrawn from the stored numbers, without measuring again, by "
                f"`python3 bench/tradeoff_report.py docs/tradeoff.csv docs/sat_search.txt docs {threads}` "

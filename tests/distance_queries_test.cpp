@@ -132,6 +132,19 @@ TEST(PointDistances, SignedUnsignedClosestPointsNaNAndCancel) {
   }
   EXPECT_LT(d[0], 0);  // the bunny's middle is inside
   EXPECT_GT(d[1], 0);
+  // Many points, searched in Morton order with each bounded by the one before: the same answers as alone.
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-0.2, 1.2);
+  std::vector<double> many(3 * 5000);
+  for (size_t i = 0; i < many.size(); ++i) many[i] = b.lo[i % 3] + u(rng) * (b.hi[i % 3] - b.lo[i % 3]);
+  std::vector<double> md(5000), mc(3 * 5000);
+  std::vector<int64_t> mp(5000);
+  pointDistances(s, many, false, {md, mp, mc});
+  for (size_t i = 0; i < 5000; ++i) {
+    const NearestHit hit = nearest.nearest({many[3 * i], many[3 * i + 1], many[3 * i + 2]});
+    ASSERT_EQ(md[i], std::sqrt(hit.squaredDistance)) << i;
+    ASSERT_EQ(mp[i], hit.primitive) << i;
+  }
   std::vector<double> bad = pts;
   bad[4] = NAN;
   EXPECT_THROW(pointDistances(s, bad, false, {d, prim, closest}), InputError);

@@ -1,11 +1,15 @@
 #include "vox/distance/queries.h"
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <utility>
+#include <vector>
 
 #include "vox/core/error.h"
 #include "vox/distance/nearest.h"
@@ -75,22 +79,69 @@ void denseSignedDistances(const Grid& grid, const Scene& scene, std::span<double
   if (progress.cancelled) fail<Error>("signed distances cancelled");
 }
 
+namespace {
+
+// The points' indices in Morton order of their positions quantized to 2^21 steps per axis over their bounding box:
+// consecutive points are then near each other, so each one's search can be bounded by the one before.
+std::vector<uint32_t> spatialOrder(std::span<const double> points) {
+  const size_t n = points.size() / 3;
+  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi = lo * -1.0;
+  for (size_t i = 0; i < n; ++i)
+    for (int a = 0; a < 3; ++a) {
+      lo.at(a) = std::min(lo[a], points[3 * i + a]);
+      hi.at(a) = std::max(hi[a], points[3 * i + a]);
+    }
+  const auto spread = [](uint64_t v) {  // the 21 bits of v at every third bit
+    v &= 0x1fffff;
+    v = (v | v << 32) & 0x1f00000000ffffull;
+    v = (v | v << 16) & 0x1f0000ff0000ffull;
+    v = (v | v << 8) & 0x100f00f00f00f00full;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ull;
+    return (v | v << 2) & 0x1249249249249249ull;
+  };
+  std::vector<std::pair<uint64_t, uint32_t>> keyed(n);
+  tbb::parallel_for(size_t(0), n, [&](size_t i) {
+    uint64_t key = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double extent = hi[a] - lo[a];
+      const double t = extent > 0 ? (points[3 * i + a] - lo[a]) / extent : 0;
+      key |= spread(uint64_t(std::clamp(t, 0.0, 1.0) * double(0x1fffff))) << a;
+    }
+    keyed[i] = {key, uint32_t(i)};
+  });
+  tbb::parallel_sort(keyed.begin(), keyed.end());
+  std::vector<uint32_t> order(n);
+  for (size_t k = 0; k < n; ++k) order[k] = keyed[k].second;
+  return order;
+}
+
+}  // namespace
+
 void pointDistances(const Scene& scene, std::span<const double> points, bool signedDistance,
                     const PointDistanceOutput& out, const DistanceQueryOptions& options) {
   const size_t n = points.size() / 3;
   for (size_t i = 0; i < points.size(); ++i)
     if (!std::isfinite(points[i]))
       fail<InputError>("points[", i / 3, ", ", i % 3, "] is ", points[i], ": coordinates must be finite");
+  if (n > UINT32_MAX) fail<LimitError>("point distances: ", n, " points, more than 2^32 - 1 in one call");
   const NearestPrimitive nearest(scene);
   std::optional<InsideTest> insideTest;
   if (signedDistance) insideTest.emplace(scene);
+  const std::vector<uint32_t> order = spatialOrder(points);
   QueryProgress progress{options, n};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
     if (progress.cancelled) return;
-    for (size_t i = r.begin(); i < r.end(); ++i) {
+    Vec3 previous;
+    double previousDistance = INFINITY;
+    for (size_t k = r.begin(); k < r.end(); ++k) {
+      const size_t i = order[k];
       const Vec3 p{points[3 * i], points[3 * i + 1], points[3 * i + 2]};
-      const NearestHit hit = nearest.nearest(p);
+      const double bound2 = k > r.begin() ? neighbourBound2(previousDistance, length(p - previous)) : INFINITY;
+      NearestHit hit = nearest.nearest(p, bound2);
+      if (hit.primitive < 0 && bound2 < INFINITY) hit = nearest.nearest(p);  // the bound was too tight after all
       const double d = std::sqrt(hit.squaredDistance);
+      previous = p;
+      previousDistance = d;
       const Vec3 c = nearest.closestPoint(hit.primitive, p);
       out.distance[i] = insideTest && d > 0 && insideTest->inside(p) ? -d : d;
       out.primitive[i] = hit.primitive;

@@ -244,12 +244,13 @@ py::array_t<double> denseSdf(const py::object& source, const py::object& resolut
     if (request.pitch) applyPitch(*request.pitch, scene, vo);
     return namedAfter(src, [&] {
       vo = vox::withCubicCells(scene, vo);
+      // The dense array is refused before any work: the plan alone gives its size.
+      vox::checkMemory(double(vox::planGrid(scene, vo).cellCount()) * 8, src.name, "sdf()");
       vox::Grid g = vox::voxelizeScene(scene, vo);
       vox::FillOptions fo;
       fo.memoryLimitBytes = vo.memoryLimitBytes;
       fo.progress = [&](double f) { return interrupt.poll(0.2 + 0.2 * f); };
       vox::fillSolid(g, scene, fo);
-      vox::checkMemory(double(g.cellCount()) * 8, src.name, "sdf()");
       std::vector<double> out(g.cellCount());
       const auto [nx, ny, nz] = g.dims;
       vox::DistanceQueryOptions qo;

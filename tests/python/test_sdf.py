@@ -92,6 +92,8 @@ def test_grid_distance_signed_unsigned_and_bad_points():
 
 
 def test_dense_sdf_refuses_bad_grids():
+    with pytest.raises(libvox.LimitError, match="sdf"):  # 8 TiB, refused from the plan before voxelizing
+        libvox.sdf(CUBE, dims=(2 ** 20, 2 ** 20, 1))
     with pytest.raises(libvox.UsageError, match="resolution"):
         libvox.sdf(CUBE, resolution=0)
     with pytest.raises(libvox.UsageError, match="at most one"):

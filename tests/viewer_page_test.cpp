@@ -3,7 +3,8 @@
 // Checks: the header's fields; every array's offset (a multiple of 8) and the total size; the rows and cells
 // giving back the grid's keys, counts and first ids; the surface's triangles being the merged mesh's, placed on
 // the lattice, one colour per vertex; widths that follow the data (u8/u16/u32 counts and palette indices, u16/u32
-// lattice); the solid runs, the scene's primitives; the HTML around the data.
+// lattice); the solid runs, the scene's primitives; the signed-distance band and the volume fractions (issue 38),
+// whose absence leaves the layout as it was; the HTML around the data.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -72,6 +73,12 @@ struct Decoded {
   std::vector<uint64_t> vertices, vertexColors, triangles, palette, rowKeys, rowStart, cellI, cellCount, cellColor, ids;
   std::vector<double> solidRuns;
   std::vector<float> sceneTriangleCoords, sphereRows;
+  // Flags bits 8 and 9: the signed-distance band (header 240-255) and the fractions.
+  uint32_t bandCount = 0, bandRowCount = 0;
+  double halfWidth = 0;
+  std::vector<uint64_t> bandRowKeys, bandRowStart, bandI;
+  std::vector<float> distances, fractions;
+  size_t fieldsAt = 0;  // where the fields' arrays start (the end of the layout of a grid without them)
 };
 
 size_t widthOf(uint32_t code) { return code == 0 ? 1 : code == 1 ? 2 : 4; }
@@ -127,6 +134,19 @@ Decoded decode(const std::string& bytes) {
   d.solidRuns = l.takeAs<double>(2 * size_t(d.solidRunCount));
   d.sceneTriangleCoords = l.takeAs<float>(9 * size_t(d.sceneTriangles));
   d.sphereRows = l.takeAs<float>(12 * size_t(d.spheres));
+  d.fieldsAt = l.at;
+  if (d.flags & 256) {
+    d.bandCount = l.get<uint32_t>(240);
+    d.bandRowCount = l.get<uint32_t>(244);
+    d.halfWidth = l.get<double>(248);
+    d.bandRowKeys = l.take(d.bandRowCount, 4);
+    d.bandRowStart = l.take(d.bandRowCount + 1, 4);
+    d.bandI = l.take(d.bandCount, coord);
+    d.distances = l.takeAs<float>(d.bandCount);
+  } else {
+    for (size_t b = 240; b < kViewerHeaderBytes; ++b) EXPECT_EQ(bytes[b], '\0') << "header byte " << b;
+  }
+  if (d.flags & 512) d.fractions = l.takeAs<float>(d.occupied);
   EXPECT_EQ(l.at, bytes.size()) << "the layout ends where its last array does";
   return d;
 }
@@ -411,6 +431,83 @@ TEST(ViewerPage, InconsistentGridIsRefused) {
   Grid grid = handGrid({2, 2, 2}, {{1, 1, 1}}, {1});
   grid.cellStart.push_back(5);
   EXPECT_THROW(encodeViewerData(grid, trianglesScene(1), {}), InputError);
+}
+
+// A band and fractions made up for the test (the layout does not care where they come from): every third cell of
+// the grid in key order, distances from the key, fractions from the cell's index.
+void addFields(Grid& grid, double halfWidth) {
+  grid.sdfHalfWidth = halfWidth;
+  for (uint64_t key = 1; key < grid.cellCount(); key += 3) {
+    grid.sdfKeys.push_back(key);
+    grid.sdfValues.push_back((double(key) - 100.3) / 7.0);
+  }
+  for (size_t c = 0; c < grid.cellKeys.size(); ++c) grid.fractions.push_back(double(c % 11) / 10.0 + 1e-9);
+}
+
+TEST(ViewerPage, DistancesAndFractionsFollowTheArrays) {
+  Grid grid;
+  const Scene scene = voxelizedBox(grid, {9, 7, 5}, true);
+  const std::string plain = encodeViewerData(grid, scene, {});
+  addFields(grid, 2.5);
+  const Decoded d = decode(encodeViewerData(grid, scene, {}));
+  EXPECT_EQ(d.flags & 768, 768u);
+  EXPECT_EQ(d.halfWidth, 2.5);
+  ASSERT_EQ(d.bandCount, grid.sdfKeys.size());
+  ASSERT_EQ(d.bandRowStart.size(), d.bandRowCount + 1u);
+  EXPECT_EQ(d.bandRowStart.back(), d.bandCount);
+  for (size_t r = 0; r < d.bandRowCount; ++r) {
+    if (r > 0) {
+      EXPECT_LT(d.bandRowKeys[r - 1], d.bandRowKeys[r]);
+    }
+    ASSERT_LT(d.bandRowStart[r], d.bandRowStart[r + 1]) << "a row holds at least one band cell";
+    for (uint64_t b = d.bandRowStart[r]; b < d.bandRowStart[r + 1]; ++b) {
+      EXPECT_EQ(d.bandI[b] + uint64_t(grid.dims[0]) * d.bandRowKeys[r], grid.sdfKeys[b]);
+      EXPECT_EQ(d.distances[b], float(grid.sdfValues[b]));
+    }
+  }
+  ASSERT_EQ(d.fractions.size(), grid.cellKeys.size());
+  for (size_t c = 0; c < grid.cellKeys.size(); ++c) EXPECT_EQ(d.fractions[c], float(grid.fractions[c]));
+
+  // Without the fields the layout is the one above up to where they start, with flags bits 8-9 and bytes 240-255
+  // cleared: pages of grids without them did not change.
+  std::string stripped = encodeViewerData(grid, scene, {}).substr(0, d.fieldsAt);
+  const uint32_t flags = d.flags & ~768u;
+  std::memcpy(stripped.data() + 12, &flags, 4);
+  std::fill(stripped.begin() + 240, stripped.begin() + kViewerHeaderBytes, '\0');
+  EXPECT_EQ(stripped, plain);
+
+  // A grid asked for distances whose band came out empty still says so (bit 8, zero counts); fractions alone.
+  Grid empty = grid;
+  empty.sdfKeys.clear();
+  empty.sdfValues.clear();
+  empty.fractions.clear();
+  const Decoded e = decode(encodeViewerData(empty, scene, {}));
+  EXPECT_EQ(e.flags & 768, 256u);
+  EXPECT_EQ(e.bandCount, 0u);
+  EXPECT_EQ(e.bandRowStart, std::vector<uint64_t>{0});
+  Grid onlyFractions = grid;
+  onlyFractions.sdfHalfWidth = 0;
+  onlyFractions.sdfKeys.clear();
+  onlyFractions.sdfValues.clear();
+  const Decoded f = decode(encodeViewerData(onlyFractions, scene, {}));
+  EXPECT_EQ(f.flags & 768, 512u);
+  EXPECT_EQ(f.fractions.size(), grid.cellKeys.size());
+}
+
+TEST(ViewerPage, FieldsThatDoNotFitTheGridAreRefused) {
+  Grid grid;
+  const Scene scene = voxelizedBox(grid, {9, 7, 5}, false);
+  addFields(grid, 3);
+  const auto refused = [&](auto change, const char* what) {
+    Grid bad = grid;
+    change(bad);
+    EXPECT_THROW(encodeViewerData(bad, scene, {}), InputError) << what;
+  };
+  refused([](Grid& g) { g.sdfValues.pop_back(); }, "fewer values than keys");
+  refused([](Grid& g) { std::swap(g.sdfKeys[0], g.sdfKeys[1]); }, "keys not ascending");
+  refused([](Grid& g) { g.sdfKeys.back() = g.cellCount(); }, "a key outside the grid");
+  refused([](Grid& g) { g.sdfHalfWidth = 0; }, "a band without a half-width");
+  refused([](Grid& g) { g.fractions.pop_back(); }, "fractions for fewer cells");
 }
 
 std::string decodeBase64(const std::string& text) {

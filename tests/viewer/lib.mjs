@@ -197,6 +197,23 @@ export function iou(a, b) {
 export const hashOf = (cam) =>
   `#eye=${cam.eye.join(',')}&look=${cam.look.join(',')}&up=${(cam.up ?? [0, 1, 0]).join(',')}&fov=${cam.fov}`;
 
+const sub = (a, b) => a.map((x, i) => x - b[i]);
+const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+const unit = (a) => a.map((x) => x / Math.hypot(...a));
+// The pointer position (CSS pixels) of world point p on a page of `size` [w, h] seen by perspective camera `cam`
+// (hashOf's {eye, look, up, fov}, fov vertical): the inverse of vox-trace's primary ray (DESIGN.md).
+export function projectPoint(cam, p, size) {
+  const dir = unit(sub(cam.look, cam.eye));
+  const right = unit(cross(dir, cam.up ?? [0, 1, 0]));
+  const up = cross(right, dir);
+  const d = sub(p, cam.eye);
+  const t = Math.tan((cam.fov * Math.PI) / 360);
+  const u = dot(d, right) / dot(d, dir);
+  const v = dot(d, up) / dot(d, dir);
+  return [(u / (t * (size[0] / size[1])) + 1) * 0.5 * size[0], (1 - v / t) * 0.5 * size[1]];
+}
+
 export function info(grid, ...flags) {
   return JSON.parse(tool('vox-info', grid, '--json', ...flags));
 }

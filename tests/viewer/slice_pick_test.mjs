@@ -8,8 +8,9 @@
 //    the cut cube's middle shows a solid cell.
 import { join } from 'node:path';
 
-import { check, coverage, finish, hashOf, info, launch, openPage, readPng, scratch, settle, source, tool }
-  from './lib.mjs';
+import {
+  check, coverage, finish, hashOf, info, launch, openPage, projectPoint, readPng, scratch, settle, source, tool,
+} from './lib.mjs';
 
 const dir = scratch('slice');
 const size = [400, 300];
@@ -20,21 +21,7 @@ tool('vox-export', cube, '-o', `${cube}.html`, '--quiet');
 const cubeInfo = info(cube, '--cells');
 check(cubeInfo.occupied_cells === 296 && cubeInfo.solid_cells === 216, 'the filled cube has 296 + 216 voxels');
 
-const sub = (a, b) => a.map((x, i) => x - b[i]);
-const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
-const unit = (a) => a.map((x) => x / Math.hypot(...a));
-// The pointer position (CSS pixels) of world point p: the inverse of vox-trace's primary ray (DESIGN.md).
-function project(cam, p) {
-  const dir = unit(sub(cam.look, cam.eye));
-  const right = unit(cross(dir, cam.up ?? [0, 1, 0]));
-  const up = cross(right, dir);
-  const d = sub(p, cam.eye);
-  const t = Math.tan((cam.fov * Math.PI) / 360);
-  const u = dot(d, right) / dot(d, dir);
-  const v = dot(d, up) / dot(d, dir);
-  return [(u / (t * (size[0] / size[1])) + 1) * 0.5 * size[0], (1 - v / t) * 0.5 * size[1]];
-}
+const project = (cam, p) => projectPoint(cam, p, size);
 
 async function slice(page, axis, pos, flip = false) {
   await page.selectOption('#vox-slice-axis', String(axis));

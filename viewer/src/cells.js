@@ -13,10 +13,48 @@ function lowerBound(array, from, to, value) {
   return from;
 }
 
+// The cells of a row table (the occupied cells, or the signed-distance band): rows j + ny * k ascending, row r
+// holding cells [start r, start r+1), each cell's i. The cell's index in the table at (i, j, k), or -1.
+function indexInRows(t, ny, i, j, k) {
+  const row = j + ny * k;
+  const r = lowerBound(t.keys, 0, t.count, row);
+  if (r === t.count || t.keys[r] !== row) return -1;
+  const c = lowerBound(t.i, t.start[r], t.start[r + 1], i);
+  return c < t.start[r + 1] && t.i[c] === i ? c : -1;
+}
+
+// Calls fn(i, j, k, c) for every cell of table `t` in layer `l` on `axis` (c: the cell's index in the table).
+function forEachRowCellInLayer(t, ny, axis, l, fn) {
+  if (axis === 2) {
+    const r0 = lowerBound(t.keys, 0, t.count, ny * l);
+    for (let r = r0; r < t.count && t.keys[r] < ny * (l + 1); ++r) {
+      const j = t.keys[r] - ny * l;
+      for (let c = t.start[r]; c < t.start[r + 1]; ++c) fn(t.i[c], j, l, c);
+    }
+    return;
+  }
+  for (let r = 0; r < t.count; ++r) {
+    const row = t.keys[r];
+    const j = row % ny;
+    const k = (row - j) / ny;
+    if (axis === 1) {
+      if (j !== l) continue;
+      for (let c = t.start[r]; c < t.start[r + 1]; ++c) fn(t.i[c], j, k, c);
+    } else {
+      const c = lowerBound(t.i, t.start[r], t.start[r + 1], l);
+      if (c < t.start[r + 1] && t.i[c] === l) fn(l, j, k, c);
+    }
+  }
+}
+
 export class Cells {
   constructor(d) {
     this.d = d;
     this.dims = d.dims;
+    this.occupiedRows = { keys: d.rowKeys, start: d.rowStart, i: d.cellI, count: d.rowCount };
+    this.bandRows = d.hasDistances
+      ? { keys: d.bandRowKeys, start: d.bandRowStart, i: d.bandI, count: d.bandRowCount }
+      : null;
     const [nx, ny, nz] = d.dims;
     this.total = d.occupiedCount + d.solidCount;
     // Voxels per layer along each axis, occupied and solid, and their prefix sums: the count on either side of a
@@ -68,12 +106,17 @@ export class Cells {
 
   // The occupied cell's index (in key order) at (i, j, k), or -1.
   occupiedIndex(i, j, k) {
-    const d = this.d;
-    const row = j + this.dims[1] * k;
-    const r = lowerBound(d.rowKeys, 0, d.rowCount, row);
-    if (r === d.rowCount || d.rowKeys[r] !== row) return -1;
-    const c = lowerBound(d.cellI, d.rowStart[r], d.rowStart[r + 1], i);
-    return c < d.rowStart[r + 1] && d.cellI[c] === i ? c : -1;
+    return indexInRows(this.occupiedRows, this.dims[1], i, j, k);
+  }
+
+  // The band cell's index (in key order) at (i, j, k), or -1 (no band, or the cell is outside it).
+  bandIndex(i, j, k) {
+    return this.bandRows ? indexInRows(this.bandRows, this.dims[1], i, j, k) : -1;
+  }
+
+  // Calls fn(i, j, k, b) for every band cell of layer `l` on `axis` (b: its index in the band).
+  forEachBandInLayer(axis, l, fn) {
+    if (this.bandRows) forEachRowCellInLayer(this.bandRows, this.dims[1], axis, l, fn);
   }
 
   isSolid(i, j, k) {
@@ -101,13 +144,25 @@ export class Cells {
     return this.inside(i, j, k) && (this.occupiedIndex(i, j, k) >= 0 || this.isSolid(i, j, k));
   }
 
-  // What the page shows of cell (i, j, k): {ijk, occupied, solid, count, ids (the stored first ones)}.
+  // What the page shows of cell (i, j, k): {ijk, occupied, solid, count, ids (the stored first ones)}, and when the
+  // grid has them `distance` (the band's float32 value, null outside the band) and `fraction` (solid cells 1, empty
+  // ones 0).
   info(i, j, k) {
     const d = this.d;
     const c = this.occupiedIndex(i, j, k);
-    if (c < 0) return { ijk: [i, j, k], occupied: false, solid: this.isSolid(i, j, k), count: 0, ids: [] };
-    const ids = Array.from(d.ids.subarray(d.idStart[c], d.idStart[c + 1]));
-    return { ijk: [i, j, k], occupied: true, solid: false, count: d.cellCount[c], ids, index: c };
+    let cell;
+    if (c < 0) {
+      cell = { ijk: [i, j, k], occupied: false, solid: this.isSolid(i, j, k), count: 0, ids: [] };
+    } else {
+      const ids = Array.from(d.ids.subarray(d.idStart[c], d.idStart[c + 1]));
+      cell = { ijk: [i, j, k], occupied: true, solid: false, count: d.cellCount[c], ids, index: c };
+    }
+    if (d.hasDistances) {
+      const b = this.bandIndex(i, j, k);
+      cell.distance = b < 0 ? null : d.distances[b];
+    }
+    if (d.hasFractions) cell.fraction = c >= 0 ? d.fractions[c] : cell.solid ? 1 : 0;
+    return cell;
   }
 
   // sRGB bytes of occupied cell c, or of the solid cells (c < 0); null without colours.
@@ -129,28 +184,7 @@ export class Cells {
 
   // Calls fn(i, j, k, c) for every voxel of layer `l` on `axis` (c: occupied index, or -1 for a solid cell).
   forEachInLayer(axis, l, fn) {
-    const d = this.d;
-    const ny = this.dims[1];
-    if (axis === 2) {
-      const r0 = lowerBound(d.rowKeys, 0, d.rowCount, ny * l);
-      for (let r = r0; r < d.rowCount && d.rowKeys[r] < ny * (l + 1); ++r) {
-        const j = d.rowKeys[r] - ny * l;
-        for (let c = d.rowStart[r]; c < d.rowStart[r + 1]; ++c) fn(d.cellI[c], j, l, c);
-      }
-    } else {
-      for (let r = 0; r < d.rowCount; ++r) {
-        const row = d.rowKeys[r];
-        const j = row % ny;
-        const k = (row - j) / ny;
-        if (axis === 1) {
-          if (j !== l) continue;
-          for (let c = d.rowStart[r]; c < d.rowStart[r + 1]; ++c) fn(d.cellI[c], j, k, c);
-        } else {
-          const c = lowerBound(d.cellI, d.rowStart[r], d.rowStart[r + 1], l);
-          if (c < d.rowStart[r + 1] && d.cellI[c] === l) fn(l, j, k, c);
-        }
-      }
-    }
+    forEachRowCellInLayer(this.occupiedRows, this.dims[1], axis, l, fn);
     this.forEachSolidSegment((i0, i1, j, k) => {
       if (axis === 0) {
         if (l >= i0 && l <= i1) fn(l, j, k, -1);
@@ -201,10 +235,16 @@ export class Cells {
     return { positions, colors, count };
   }
 
-  // The first voxel that a ray meets, walking the cells front to back (Amanatides and Woo 1987) from the ray's
-  // origin (lattice space; direction need not be unit). `keep(i, j, k)` says whether a voxel is drawn (the slice).
-  // Returns {ijk, t, axis (entry face's axis, -1 when the ray starts inside)} or null.
+  // The first voxel that a ray meets (origin and direction as firstCell's); `keep(i, j, k)` says whether a voxel is
+  // drawn (the slice).
   firstVoxel(origin, dir, keep = () => true) {
+    return this.firstCell(origin, dir, (i, j, k) => this.isVoxel(i, j, k) && keep(i, j, k));
+  }
+
+  // The first cell for which `hit(i, j, k)` holds along a ray, walking the cells front to back (Amanatides and Woo
+  // 1987) from the ray's origin (lattice space; direction need not be unit): voxels, or the cells the slice plane
+  // shows a field on. Returns {ijk, t, axis (entry face's axis, -1 when the ray starts inside)} or null.
+  firstCell(origin, dir, hit) {
     const n = this.dims;
     let t0 = 0;
     let t1 = Infinity;
@@ -249,8 +289,7 @@ export class Cells {
     }
     let t = t0;
     for (let steps = n[0] + n[1] + n[2] + 3; steps > 0; --steps) {
-      if (this.isVoxel(cell[0], cell[1], cell[2]) && keep(cell[0], cell[1], cell[2]))
-        return { ijk: cell.slice(), t, axis };
+      if (hit(cell[0], cell[1], cell[2])) return { ijk: cell.slice(), t, axis };
       let a = tMax[0] < tMax[1] ? (tMax[0] < tMax[2] ? 0 : 2) : tMax[1] < tMax[2] ? 1 : 2;
       t = tMax[a];
       if (t > t1) return null;

@@ -107,7 +107,18 @@ export function decodeViewerData(bytes) {
     sphereCount: u32(224),
     primitiveCount: u32(228),
     planeCount: u32(236),
+    // Flags bits 8 and 9: the grid's signed-distance band and volume fractions (issue 38), arrays at the end.
+    hasDistances: (flags & 256) !== 0,
+    hasFractions: (flags & 512) !== 0,
+    bandCount: 0,
+    bandRowCount: 0,
+    halfWidth: 0,
   };
+  if (d.hasDistances) {
+    d.bandCount = u32(240);
+    d.bandRowCount = u32(244);
+    d.halfWidth = f64(248);
+  }
   const titleBytes = u32(232);
   d.centre = [0, 1, 2].map((a) => (d.lo[a] + d.hi[a]) * 0.5);
 
@@ -135,6 +146,11 @@ export function decodeViewerData(bytes) {
   d.solidRuns = take(Float64Array, 2 * d.solidRunCount);
   d.sceneTriangles = take(Float32Array, 9 * d.sceneTriangleCount);
   d.spheres = take(Float32Array, 12 * d.sphereCount);
+  d.bandRowKeys = d.hasDistances ? take(Uint32Array, d.bandRowCount) : null;
+  d.bandRowStart = d.hasDistances ? take(Uint32Array, d.bandRowCount + 1) : null;
+  d.bandI = d.hasDistances ? take(Coord, d.bandCount) : null;
+  d.distances = d.hasDistances ? take(Float32Array, d.bandCount) : null;
+  d.fractions = d.hasFractions ? take(Float32Array, d.occupiedCount) : null;
   if (at !== bytes.length) throw new LayoutError(`viewer data: ${bytes.length} bytes, the layout ends at ${at}`);
 
   // Where each cell's stored ids start (min(count, idsPerCell) each, in cell order).
@@ -145,6 +161,8 @@ export function decodeViewerData(bytes) {
   }
   if (d.idStart[d.occupiedCount] !== d.idCount) throw new LayoutError('viewer data: stored ids do not match the counts');
   if (d.rowStart[d.rowCount] !== d.occupiedCount) throw new LayoutError('viewer data: rows do not cover the cells');
+  if (d.hasDistances && d.bandRowStart[d.bandRowCount] !== d.bandCount)
+    throw new LayoutError('viewer data: band rows do not cover the band');
   d.solidCount = 0;
   for (let r = 0; r < d.solidRunCount; ++r) d.solidCount += d.solidRuns[2 * r + 1];
   return d;

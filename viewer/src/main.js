@@ -7,7 +7,8 @@ import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { decodeViewerData, layoutFromElements } from './data.js';
 import { formatHash, parseHash, resolveCamera, verticalView } from './camera.js';
 import { Cells } from './cells.js';
-import { cubes, surfaceMaterial } from './surface.js';
+import { cubes, fieldMaterial, surfaceMaterial } from './surface.js';
+import { availableFields, fieldQuads, keptLayer, showsField } from './field.js';
 import { blockFactor, blockSurface } from './lod.js';
 import { buildPanel } from './panel.js';
 
@@ -87,6 +88,11 @@ async function start() {
     fullMesh = mesh;
   }
   let capMesh = null;
+  // The slice plane's field (field.js): signed distances or volume fractions on the kept layer, when the grid has
+  // them; 'voxels' draws the plane as grids without them do.
+  let fieldMesh = null;
+  let field = availableFields(data)[0];
+  const fieldMat = fieldMaterial(surface);
   // Large surfaces: a coarse stand-in (lod.js) for the first frame and while the camera moves.
   const lod = { mesh: null, factor: 1, coarse: false, timer: 0 };
   api.lod = lod;
@@ -347,10 +353,36 @@ async function start() {
       capMesh.frustumCulled = false;
       voxels.add(capMesh);
     }
+    buildField();
     const shown = cells.keptCount(slice.axis, slice.pos, keepBelow);
     api.shownVoxels = shown;
     api.capFaces = caps.count;
     panel.setShown(shown, cells.total);
+    pick.refresh();
+    render();
+  }
+  // The field's quads on the slice plane, rebuilt with the slice or the field.
+  function buildField() {
+    if (fieldMesh) {
+      voxels.remove(fieldMesh);
+      fieldMesh.geometry.dispose();
+      fieldMesh = null;
+    }
+    const quads = fieldQuads(cells, field, slice.axis, slice.pos, slice.keepBelow);
+    api.fieldCells = quads.count;
+    api.field = field;
+    if (quads.count === 0) return;
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('lattice', new THREE.BufferAttribute(quads.positions, 3));
+    g.setAttribute('vcolor', new THREE.BufferAttribute(quads.colors, 3, true));
+    g.setIndex(new THREE.BufferAttribute(Uint32Array.from({ length: 6 * quads.count }, (_, v) => v), 1));
+    fieldMesh = new THREE.Mesh(g, fieldMat);
+    fieldMesh.frustumCulled = false;
+    voxels.add(fieldMesh);
+  }
+  function setField(f) {
+    field = f;
+    buildField();
     pick.refresh();
     render();
   }
@@ -375,7 +407,11 @@ async function start() {
       raycaster.setFromCamera(ndc, camera);
       const o = toLattice(raycaster.ray.origin.toArray());
       const d = raycaster.ray.direction.toArray().map((x, a) => x / cellSize[a]);
-      const hit = cells.firstVoxel(o, d, keepCell);
+      // Voxels, and the cells whose field the slice plane shows (the band's empty cells too).
+      const layer = keptLayer(data.dims, slice.axis, slice.pos, slice.keepBelow);
+      const shows = (i, j, k) =>
+        keepCell(i, j, k) && (cells.isVoxel(i, j, k) || showsField(cells, field, slice.axis, layer, i, j, k));
+      const hit = cells.firstCell(o, d, shows);
       return hit ? cells.info(...hit.ijk) : null;
     },
     show() {
@@ -399,6 +435,7 @@ async function start() {
 
   const panel = buildPanel(data, cells, {
     slice: (axis, pos, keepBelow) => setSlice(axis, pos, keepBelow),
+    field: (f) => setField(f),
     toggle: (what, on) => {
       if (what === 'triangles') overlay.visible = on;
       else if (what === 'bounds') boundsLines.visible = on;
@@ -466,6 +503,7 @@ async function start() {
     return (performance.now() - t0) / n;
   };
   api.setSlice = setSlice;
+  api.setField = setField;
   api.pickAt = (x, y) => pick.at(x, y);
   api.view = () => currentView();
   api.render = render;

@@ -1,5 +1,8 @@
 // The page's controls and read-outs: the grid's facts, the slice plane, the overlays' toggles and the cell under
-// the pointer. Plain DOM; the elements have ids (vox-...) that tests and users' scripts can rely on.
+// the pointer (with its signed distance and volume fraction when the grid has them). Plain DOM; the elements have ids
+// (vox-...) that tests and users' scripts can rely on.
+
+import { INSIDE_COLOR, OUTSIDE_COLOR, availableFields, distanceLimit } from './field.js';
 
 const css = `
 html, body { margin: 0; height: 100%; overflow: hidden; background: #000; }
@@ -14,10 +17,14 @@ html, body { margin: 0; height: 100%; overflow: hidden; background: #000; }
 #vox-panel label { white-space: nowrap; }
 #vox-info { margin-top: 6px; padding-top: 5px; border-top: 1px solid #bbb; font-family: ui-monospace, monospace;
   min-height: 2.9em; overflow-wrap: anywhere; }
+#vox-legend { flex: 1; min-width: 8em; height: 10px; border: 1px solid #888; }
 #vox-help { margin-top: 5px; color: #555; font-size: 11px; }
 `;
 
 const fmt = (n) => Number(n).toLocaleString('en-US');
+// A field's value as the read-out shows it: the float32 value to 7 significant digits (all it holds).
+const fmtValue = (v) => String(Number(v.toPrecision(7)));
+const FIELD_NAMES = { distance: 'signed distance', fraction: 'volume fraction', voxels: 'voxel colours' };
 
 function el(tag, attrs = {}, ...children) {
   const e = document.createElement(tag);
@@ -36,7 +43,48 @@ function checkbox(id, text, checked, onChange) {
   return el('label', { for: id }, box, ` ${text}`);
 }
 
-// actions: {slice(axis, pos, keepBelow), toggle(what, on), resetCamera()}.
+// The slice plane's choice of field and its colour scale, for a grid with signed distances or volume fractions
+// (field.js); null for one without.
+function fieldRow(data, actions) {
+  const fields = availableFields(data);
+  if (fields.length < 2) return null;
+  const select = el('select', { id: 'vox-slice-field', 'aria-label': 'what the slice plane shows' });
+  for (const f of fields) select.append(el('option', { value: f, text: FIELD_NAMES[f] }));
+  const legend = el('span', { id: 'vox-legend' });
+  const range = el('span', { id: 'vox-legend-range' });
+  const rgb = (c) => `rgb(${c.join(',')})`;
+  const show = () => {
+    const f = select.value;
+    legend.style.display = f === 'voxels' ? 'none' : '';
+    if (f === 'distance') {
+      const limit = fmtValue(distanceLimit(data));
+      legend.style.background = `linear-gradient(to right, ${rgb(INSIDE_COLOR)}, #fff, ${rgb(OUTSIDE_COLOR)})`;
+      range.textContent = `−${limit} … ${limit}`;
+    } else if (f === 'fraction') {
+      legend.style.background = 'linear-gradient(to right, #000, #fff)';
+      range.textContent = '0 … 1';
+    } else {
+      range.textContent = '';
+    }
+  };
+  select.addEventListener('change', () => {
+    show();
+    actions.field(select.value);
+  });
+  show();
+  return el('div', { class: 'row' }, el('label', { for: 'vox-slice-field' }, 'plane: '), select, legend, range);
+}
+
+// The read-out's words for a cell's fields: its signed distance (or that it lies outside the band) and fraction.
+function fieldText(cell) {
+  let text = '';
+  if (cell.distance !== undefined)
+    text += cell.distance === null ? ' · outside the distance band' : ` · signed distance ${fmtValue(cell.distance)}`;
+  if (cell.fraction !== undefined) text += ` · volume fraction ${fmtValue(cell.fraction)}`;
+  return text;
+}
+
+// actions: {slice(axis, pos, keepBelow), field(name), toggle(what, on), resetCamera()}.
 export function buildPanel(data, cells, actions) {
   document.head.append(el('style', { text: css }));
   const [nx, ny, nz] = data.dims;
@@ -49,7 +97,9 @@ export function buildPanel(data, cells, actions) {
       text:
         `${nx} × ${ny} × ${nz} cells · ${fmt(data.occupiedCount)} occupied` +
         (data.solidCount ? ` · ${fmt(data.solidCount)} solid` : '') +
-        ` · ${prims} · colour: ${data.colorMode}`,
+        ` · ${prims} · colour: ${data.colorMode}` +
+        (data.hasDistances ? ` · signed distances: ${fmt(data.bandCount)} band cells` : '') +
+        (data.hasFractions ? ' · volume fractions' : ''),
     }),
   );
 
@@ -87,6 +137,8 @@ export function buildPanel(data, cells, actions) {
     el('div', { class: 'row' }, axisSelect, slider, sliceValue),
     el('div', { class: 'row' }, el('label', { for: 'vox-slice-flip' }, flip, ' keep the far side')),
   );
+  const fields = fieldRow(data, actions);
+  if (fields) panel.append(fields);
   const shown = el('div', { id: 'vox-shown' });
   panel.append(shown);
 
@@ -126,6 +178,8 @@ export function buildPanel(data, cells, actions) {
         delete info.dataset.ijk;
         delete info.dataset.count;
         delete info.dataset.ids;
+        delete info.dataset.distance;
+        delete info.dataset.fraction;
         return;
       }
       const [i, j, k] = cell.ijk;
@@ -136,14 +190,20 @@ export function buildPanel(data, cells, actions) {
           text += `, ${cell.ids.length < cell.count ? `first ${cell.ids.length} ` : ''}id${
             cell.ids.length === 1 ? '' : 's'
           } ${cell.ids.join(', ')}`;
-      } else {
+      } else if (cell.solid) {
         text += 'solid (inside, no primitive)';
+      } else {
+        text += 'empty';
       }
+      text += fieldText(cell);
       info.textContent = text;
       info.dataset.ijk = `${i},${j},${k}`;
       info.dataset.count = String(cell.count);
       info.dataset.ids = cell.ids.join(',');
       info.dataset.solid = cell.solid ? '1' : '0';
+      // The values as the page holds them (float32, all digits): tests compare them with the grid's.
+      if (cell.distance !== undefined) info.dataset.distance = cell.distance === null ? '' : String(cell.distance);
+      if (cell.fraction !== undefined) info.dataset.fraction = String(cell.fraction);
     },
     toggleHidden() {
       panel.classList.toggle('hidden');

@@ -50,6 +50,10 @@ void main() {
   vec3 an = abs(n);
   int axis = an.x > an.y ? (an.x > an.z ? 0 : 2) : (an.y > an.z ? 1 : 2);
   float side = axis == 0 ? sign(n.x) : axis == 1 ? sign(n.y) : sign(n.z);
+#ifdef VOX_FLAT
+  // The slice plane's field (fieldMaterial): on the plane, unlit, so the map's colours read as they are.
+  float shade = 1.0;
+#else
   if (uSliceAxis >= 0) {
     // The cell this fragment belongs to, half a cell inside the face: dropped when on the removed side.
     float coord = uSliceAxis == 0 ? vLattice.x : uSliceAxis == 1 ? vLattice.y : vLattice.z;
@@ -58,6 +62,7 @@ void main() {
   }
   // Light by the face's axis (top brightest, bottom darkest), as voxel editors do: every face of a voxel reads.
   float shade = axis == 1 ? (side > 0.0 ? 1.0 : 0.55) : axis == 0 ? 0.82 : 0.68;
+#endif
   vec3 color = vColor * shade;
   if (uLines == 1) {
     vec3 w = fwidth(vLattice);
@@ -90,6 +95,22 @@ export function surfaceMaterial(data, origin, cell, instanced = false) {
       uLines: { value: 0 },
     },
     side: THREE.DoubleSide,
+  });
+}
+
+// The material of the slice plane's field quads (field.js): vertex colours, unlit, the surface's uniforms (cell
+// lines). Drawn over the voxels' faces that lie on the plane: pulled towards the camera by a polygon offset, as
+// the quads and those faces are coplanar.
+export function fieldMaterial(surface) {
+  return new THREE.ShaderMaterial({
+    vertexShader,
+    fragmentShader,
+    defines: { VOX_COLORS: 1, VOX_FLAT: 1 },
+    uniforms: surface.uniforms,
+    side: THREE.DoubleSide,
+    polygonOffset: true,
+    polygonOffsetFactor: -1,
+    polygonOffsetUnits: -4,
   });
 }
 

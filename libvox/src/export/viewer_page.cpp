@@ -193,6 +193,60 @@ void emitPage(std::string_view data, const std::string& title, Sink&& sink) {
 #endif
 }
 
+// The signed-distance band in the layout's row form (the occupied cells' form): rows (j, k) ascending, each cell's i.
+struct BandRows {
+  std::vector<uint32_t> keys, start, i;
+};
+
+// Refuses a band or fractions that do not fit the grid (a reader of the page would index past its arrays).
+void checkFields(const Grid& grid) {
+  const uint64_t cells = uint64_t(grid.dims[0]) * grid.dims[1] * grid.dims[2];
+  if (grid.sdfKeys.size() != grid.sdfValues.size())
+    fail<InputError>("grid: ", grid.sdfKeys.size(), " signed-distance keys but ", grid.sdfValues.size(), " values");
+  if (!(grid.sdfHalfWidth >= 0) || (grid.sdfHalfWidth == 0 && !grid.sdfKeys.empty()))
+    fail<InputError>("grid: signed distances with a band half-width of ", grid.sdfHalfWidth, " cells");
+  for (size_t b = 0; b < grid.sdfKeys.size(); ++b)
+    if (grid.sdfKeys[b] >= cells || (b > 0 && grid.sdfKeys[b] <= grid.sdfKeys[b - 1]))
+      fail<InputError>("grid: signed-distance keys not ascending inside the grid (key ", grid.sdfKeys[b], ")");
+  if (!grid.fractions.empty() && grid.fractions.size() != grid.cellKeys.size())
+    fail<InputError>("grid: ", grid.fractions.size(), " volume fractions for ", grid.cellKeys.size(),
+                     " occupied cells");
+}
+
+BandRows bandRows(const Grid& grid) {
+  BandRows rows;
+  const uint32_t nBand = checked32(grid.sdfKeys.size(), "signed-distance cells");
+  rows.i.reserve(nBand);
+  for (uint32_t b = 0; b < nBand; ++b) {
+    const uint64_t key = grid.sdfKeys[b];
+    const auto row = uint32_t(key / grid.dims[0]);  // < ny * nz, checked to fit
+    if (rows.keys.empty() || rows.keys.back() != row) {
+      rows.keys.push_back(row);
+      rows.start.push_back(b);
+    }
+    rows.i.push_back(uint32_t(key % grid.dims[0]));
+  }
+  rows.start.push_back(nBand);
+  return rows;
+}
+
+// The band (rows, each cell's i, the distances) and the fractions, as float32: the page shows colours and a read-out
+// of 7 significant digits, so half the bytes of doubles.
+void putFields(ByteWriter& w, const Grid& grid, const BandRows& band, bool hasBand, uint32_t coordWidth) {
+  if (hasBand) {
+    for (uint32_t r : band.keys) w.put(r);
+    w.align();
+    for (uint32_t s : band.start) w.put(s);
+    w.align();
+    for (uint32_t i : band.i) w.putUint(i, coordWidth);
+    w.align();
+    for (double v : grid.sdfValues) w.put(float(v));
+    w.align();
+  }
+  for (double f : grid.fractions) w.put(float(f));
+  w.align();
+}
+
 }  // namespace
 
 bool viewerPageAvailable() {
@@ -212,6 +266,12 @@ std::string encodeViewerData(const Grid& grid, const Scene& scene, const ViewerP
   checked32(uint64_t(dims[1]) * dims[2], "rows of cells (ny * nz)");
   checked32(nOcc, "occupied cells");
   checked32(grid.solidRuns.size(), "solid runs");
+  checkFields(grid);
+  // A band (even an empty one: the grid was asked for distances) and fractions add flag bits 8 and 9 and arrays at
+  // the end; without them the layout is the one pages had before.
+  const bool hasBand = grid.sdfHalfWidth > 0;
+  const bool hasFractions = !grid.fractions.empty();
+  const BandRows band = hasBand ? bandRows(grid) : BandRows{};
   const bool colors = options.color != ColorMode::None;
   const bool wide = std::max({dims[0], dims[1], dims[2]}) > 0xffff;
   const uint32_t coordWidth = wide ? 4 : 2;
@@ -290,12 +350,15 @@ std::string encodeViewerData(const Grid& grid, const Scene& scene, const ViewerP
 
   ByteWriter w;
   w.bytes.reserve(kViewerHeaderBytes + pageVertexSource.size() * (3 * coordWidth + 3) + triangles.size() * 4 +
-                  nOcc * (coordWidth + countWidth + paletteWidth) + idCount * 4);
+                  nOcc * (coordWidth + countWidth + paletteWidth) + idCount * 4 +
+                  (band.keys.size() + band.start.size()) * 4 + band.i.size() * (coordWidth + 4) +
+                  grid.fractions.size() * 4);
   w.bytes.append("VOXVIEW", 8);  // with its terminating zero
   w.put(kViewerDataVersion);
   const uint32_t flags = (colors ? 1u : 0u) | (wide ? 2u : 0u) | widthCode(countWidth) << 2 |
                          widthCode(paletteWidth) << 4 | (camera.kind == CameraKind::Orthographic ? 64u : 0u) |
-                         (camera.span == CameraSpan::LongerSide ? 128u : 0u);
+                         (camera.span == CameraSpan::LongerSide ? 128u : 0u) | (hasBand ? 256u : 0u) |
+                         (hasFractions ? 512u : 0u);
   w.put(flags);
   for (int a = 0; a < 3; ++a) w.put(grid.bounds.lo[a]);
   for (int a = 0; a < 3; ++a) w.put(grid.bounds.hi[a]);
@@ -323,6 +386,11 @@ std::string encodeViewerData(const Grid& grid, const Scene& scene, const ViewerP
   w.put(checked32(scene.primitiveCount(), "primitives"));
   w.put(checked32(title.size(), "title bytes"));
   w.put(checked32(scene.planes.size(), "scene planes"));
+  if (hasBand) {
+    w.put(uint32_t(grid.sdfKeys.size()));  // checked by bandRows
+    w.put(uint32_t(band.keys.size()));
+    w.put(grid.sdfHalfWidth);
+  }
   VOX_CHECK(w.bytes.size() <= kViewerHeaderBytes);
   w.bytes.resize(kViewerHeaderBytes, '\0');
 
@@ -377,6 +445,7 @@ std::string encodeViewerData(const Grid& grid, const Scene& scene, const ViewerP
       for (int c = 0; c < 4; ++c) w.put(float(m.m[r][c]));
   }
   w.align();
+  putFields(w, grid, band, hasBand, coordWidth);
 
   if (stats) {
     stats->voxels = nOcc + grid.solidCount();  // a grid's cells are occupied or solid, never both

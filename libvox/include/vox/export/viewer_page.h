@@ -42,10 +42,14 @@ struct ViewerDataStats {
 //    that every vertex has one colour;
 //  - the occupied cells in key order, grouped by row (j, k): each cell's i, primitive count, palette colour and its
 //    first min(count, idsPerCell) primitive ids; the solid runs;
-//  - the scene's triangles and spheres (float, relative to the bounds' centre), for the page's triangle overlay.
+//  - the scene's triangles and spheres (float, relative to the bounds' centre), for the page's triangle overlay;
+//  - when the grid has them (flags bits 8 and 9), the signed-distance band in the same row form as the occupied
+//    cells with each distance as float32, and each occupied cell's volume fraction as float32, which the page's
+//    slice plane shows. A grid without them gives the layout it gave before they existed.
 // Colours are vox-export's (occupiedCellColors; solid cells kSolidCellColor); ColorMode::None stores none.
 // Throws InputError for an inconsistent grid (as buildVoxelMesh), LimitError when a count exceeds the layout's 32-bit
-// fields (more than 2^32 - 1 vertices, triangles, cells or ids, or ny * nz >= 2^32).
+// fields (more than 2^32 - 1 vertices, triangles, cells, band cells or ids, or ny * nz >= 2^32). InputError also
+// for a band or fractions that do not fit the grid (keys not ascending or outside it, counts that differ).
 std::string encodeViewerData(const Grid& grid, const Scene& scene, const ViewerPageOptions& options,
                              ViewerDataStats* stats = nullptr);
 

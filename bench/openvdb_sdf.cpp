@@ -3,10 +3,6 @@
 // by `vox-voxelize SCENE --res RES --sdf HALF`, also compares the two fields on the cells both hold: OpenVDB's sign
 // errors (ours are exact: tests/distance_test.cpp) and the largest difference of the magnitudes, in voxels.
 // Usage: openvdb_sdf SCENE RES [HALF] [THREADS] [GRID.vgrid]
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
-#include <CGAL/Side_of_triangle_mesh.h>
-#include <CGAL/Surface_mesh.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/MeshToVolume.h>
 #include <sys/resource.h>
@@ -20,6 +16,7 @@
 #include <memory>
 #include <string>
 
+#include "exact_side.h"
 #include "vox/distance/sdf.h"
 #include "vox/import/import.h"
 #include "vox/io/grid_file.h"
@@ -49,40 +46,13 @@ double quantile(std::vector<double>& v, double q) {
   return *at;
 }
 
-// CGAL's exact inside test of a closed mesh: the arbiter of the cells where OpenVDB and libvox disagree.
-class CgalSide {
- public:
-  using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-  explicit CgalSide(const vox::Scene& scene) {
-    std::map<std::array<double, 3>, size_t> index;
-    std::vector<Kernel::Point_3> points;
-    std::vector<std::vector<size_t>> faces;
-    for (const auto& t : scene.triangles) {
-      std::vector<size_t> f;
-      for (const auto& v : t.v) {
-        const auto [it, added] = index.emplace(std::array<double, 3>{v.x, v.y, v.z}, points.size());
-        if (added) points.emplace_back(v.x, v.y, v.z);
-        f.push_back(it->second);
-      }
-      faces.push_back(f);
-    }
-    CGAL::Polygon_mesh_processing::polygon_soup_to_polygon_mesh(points, faces, mesh_);
-    side_ = std::make_unique<CGAL::Side_of_triangle_mesh<Mesh, Kernel>>(mesh_);
-  }
-  bool inside(const vox::Vec3& p) const { return (*side_)(Kernel::Point_3(p.x, p.y, p.z)) == CGAL::ON_BOUNDED_SIDE; }
-
- private:
-  using Mesh = CGAL::Surface_mesh<Kernel::Point_3>;
-  Mesh mesh_;
-  std::unique_ptr<CGAL::Side_of_triangle_mesh<Mesh, Kernel>> side_;
-};
-
 // OpenVDB's field against ours on the band cells both hold; where the signs differ and the mesh is closed, CGAL's
 // exact inside test says who is right.
 void compare(const openvdb::FloatGrid& vdb, const vox::Grid& ours, const vox::Scene& scene, double voxel) {
-  std::unique_ptr<CgalSide> cgal;
+  std::unique_ptr<vox::testing::ExactSide> cgal;
   if (vox::countOpenEdges({scene.triangles.data(), scene.triangles.size()}) == 0)
-    cgal = std::make_unique<CgalSide>(scene);
+    cgal = std::make_unique<vox::testing::ExactSide>(
+        std::vector<vox::Triangle>(scene.triangles.begin(), scene.triangles.end()));
   uint64_t cgalAgreesWithUs = 0, cgalAgreesWithOpenVdb = 0;
   const auto acc = vdb.getConstAccessor();
   uint64_t both = 0, insideAsOutside = 0, outsideAsInside = 0;
@@ -97,7 +67,8 @@ void compare(const openvdb::FloatGrid& vdb, const vox::Grid& ours, const vox::Sc
     if (o < 0 && v >= 0) ++insideAsOutside;
     if (o > 0 && v < 0) ++outsideAsInside;
     if (disagree && cgal)
-      ++((cgal->inside(vox::cellCentre(ours, ours.sdfKeys[b])) == (o < 0)) ? cgalAgreesWithUs : cgalAgreesWithOpenVdb);
+      ++(((cgal->side(vox::cellCentre(ours, ours.sdfKeys[b])) < 0) == (o < 0)) ? cgalAgreesWithUs
+                                                                               : cgalAgreesWithOpenVdb);
     differences.push_back(std::fabs(std::fabs(double(v)) - std::fabs(o)) / voxel);
   }
   std::printf(

@@ -15,6 +15,7 @@
 #include <map>
 #include <random>
 
+#include "exact_side.h"
 #include "test_util.h"
 #include "vox/core/error.h"
 #include "vox/distance/closest_point.h"
@@ -155,37 +156,7 @@ TEST(DistanceWinding, APointOneUlpInsideAFaceCountsInside) {
   EXPECT_NEAR(windingNumberExact({box.triangles.data(), box.triangles.size()}, nearFace), 1, 1e-9);
 }
 
-// CGAL's exact inside test of a closed triangle soup.
-class ExactSide {
- public:
-  explicit ExactSide(const std::vector<Triangle>& triangles) {
-    using Epick = CGAL::Exact_predicates_inexact_constructions_kernel;
-    std::map<std::array<double, 3>, size_t> index;
-    std::vector<Epick::Point_3> points;
-    std::vector<std::vector<size_t>> faces;
-    for (const Triangle& t : triangles) {
-      std::vector<size_t> f;
-      for (const Vec3& v : t.v) {
-        const auto [it, added] = index.emplace(std::array<double, 3>{v.x, v.y, v.z}, points.size());
-        if (added) points.emplace_back(v.x, v.y, v.z);
-        f.push_back(it->second);
-      }
-      faces.push_back(f);
-    }
-    CGAL::Polygon_mesh_processing::polygon_soup_to_polygon_mesh(points, faces, mesh_);
-    side_ = std::make_unique<CGAL::Side_of_triangle_mesh<Mesh, Epick>>(mesh_);
-  }
-  // -1 inside, 0 on the boundary, 1 outside.
-  int side(const Vec3& p) const {
-    const auto s = (*side_)(CGAL::Exact_predicates_inexact_constructions_kernel::Point_3(p.x, p.y, p.z));
-    return s == CGAL::ON_BOUNDED_SIDE ? -1 : (s == CGAL::ON_BOUNDARY ? 0 : 1);
-  }
-
- private:
-  using Mesh = CGAL::Surface_mesh<CGAL::Exact_predicates_inexact_constructions_kernel::Point_3>;
-  Mesh mesh_;
-  std::unique_ptr<CGAL::Side_of_triangle_mesh<Mesh, CGAL::Exact_predicates_inexact_constructions_kernel>> side_;
-};
+using testing::ExactSide;
 
 Grid filledGrid(const Scene& scene, std::array<uint32_t, 3> dims, const Box* bounds = nullptr) {
   VoxelizeOptions o;

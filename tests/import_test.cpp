@@ -794,6 +794,35 @@ TEST(ImportPly, StanfordBunnyMatchesItsObjConversion) {
         ASSERT_EQ(bitsOf(ply.triangles[i].v[k][a]), bitsOf(obj.triangles[i].v[k][a])) << "triangle " << i;
 }
 
+// loadScene's progress: a callback that says stop cancels the PLY and OBJ readers with vox::Error "PATH: reading
+// cancelled" (no subclass), whichever call it stops at; one that lets them run changes nothing.
+TEST(ImportProgress, StopCancelsThePlyAndObjReaders) {
+  for (const std::string& path : {seed("meshes/bun_zipper.ply"), seed("meshes/derived/stanford_bunny_69k.obj")}) {
+    std::atomic<int> calls{0};
+    std::atomic<bool> outside{false};
+    const Scene watched = loadScene(path, [&](double f) {
+      outside = outside || !(f >= 0 && f <= 1);
+      ++calls;
+      return true;
+    });
+    EXPECT_EQ(watched.triangles.size(), 69451u) << path;
+    EXPECT_FALSE(outside) << path;
+    const int total = calls;
+    EXPECT_GT(total, 10) << path;  // asked often: the binding's Ctrl-C waits on it
+    for (int stopAt : {0, total / 2, total - 1}) {
+      std::atomic<int> n{0};
+      try {
+        loadScene(path, [&](double) { return n++ != stopAt; });
+        ADD_FAILURE() << path << ": not cancelled at call " << stopAt << " of " << total;
+      } catch (const InputError& e) {
+        ADD_FAILURE() << e.what();
+      } catch (const Error& e) {
+        EXPECT_EQ(std::string(e.what()), path + ": reading cancelled");
+      }
+    }
+  }
+}
+
 TEST(ImportPly, SmallAsciiAndTruncated) {
   TempDir dir;
   const std::string header =

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <functional>
 #include <map>
@@ -608,6 +609,68 @@ TEST(VoxelMesh, SparseGridFarApartUsesLittleMemory) {
   const VoxelMesh m = buildVoxelMesh(g, makeScene(), FaceMode::Merged, ColorMode::None);
   EXPECT_EQ(m.faceCount(), 12u);
   EXPECT_EQ(m.vertexCount(), 16u);
+}
+
+// Stops at its call number stopAt (counted from 0) and checks that every fraction lies in [0, 1].
+struct StopAt {
+  int stopAt = -1;
+  std::atomic<int> calls{0};
+  std::atomic<bool> outside{false};
+  bool operator()(double f) {
+    if (!(f >= 0 && f <= 1)) outside = true;
+    return calls++ != stopAt;
+  }
+};
+
+// `work(progress)` throws vox::Error "<what> cancelled" (no subclass) whichever call of `progress` says stop: the
+// first, a middle one, the last.
+void expectCancels(const std::function<void(const std::function<bool(double)>&)>& work, const std::string& what) {
+  StopAt count;
+  work(std::ref(count));
+  const int total = count.calls;
+  EXPECT_GT(total, 20) << what;  // asked often: the binding's Ctrl-C waits on it
+  EXPECT_FALSE(count.outside) << what;
+  for (int stopAt : {0, 1, total / 3, total / 2, total - 1}) {
+    StopAt stop;
+    stop.stopAt = stopAt;
+    try {
+      work(std::ref(stop));
+      ADD_FAILURE() << what << ": not cancelled at call " << stopAt << " of " << total;
+    } catch (const InputError& e) {
+      ADD_FAILURE() << what << ": " << e.what();
+    } catch (const LimitError& e) {
+      ADD_FAILURE() << what << ": " << e.what();
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()), what + " cancelled") << "call " << stopAt << " of " << total;
+    }
+  }
+}
+
+TEST(VoxelMesh, ProgressSaysStopAndTheBuildThrows) {
+  std::mt19937 rng(5);
+  const std::array<uint32_t, 3> dims{48, 40, 36};
+  const IntCellSet cells = randomCells(rng, dims, 0.3);
+  const Grid g = makeGrid(dims, cells, {{0, 0, 0}, {47, 39, 35}});
+  const Scene scene = makeScene();
+  for (FaceMode mode : {FaceMode::All, FaceMode::Exposed, FaceMode::Merged}) {
+    const std::string name = faceModeName(mode);
+    // A callback that lets it run changes nothing.
+    const VoxelMesh plain = buildVoxelMesh(g, scene, mode, ColorMode::Material);
+    const VoxelMesh watched = buildVoxelMesh(g, scene, mode, ColorMode::Material, nullptr, [](double) { return true; });
+    EXPECT_EQ(watched.vertexCount(), plain.vertexCount()) << name;
+    EXPECT_EQ(watched.faceVertices, plain.faceVertices) << name;
+    EXPECT_EQ(watched.faceStart, plain.faceStart) << name;
+    EXPECT_EQ(watched.faceColors, plain.faceColors) << name;
+    expectCancels(
+        [&](const std::function<bool(double)>& p) { buildVoxelMesh(g, scene, mode, ColorMode::Material, nullptr, p); },
+        "voxel mesh");
+    expectCancels([&](const std::function<bool(double)>& p) { triangulateVoxelMesh(plain, p); }, "triangulation");
+  }
+  for (ColorMode color : {ColorMode::Count, ColorMode::Material}) {
+    EXPECT_EQ(occupiedCellColors(g, scene, color, 0, [](double) { return true; }), occupiedCellColors(g, scene, color));
+    expectCancels([&](const std::function<bool(double)>& p) { occupiedCellColors(g, scene, color, 0, p); },
+                  "cell colours");
+  }
 }
 
 }  // namespace

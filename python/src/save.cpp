@@ -100,10 +100,12 @@ void save(PyGrid& self, const py::object& pathObj, const py::object& facesName, 
     } else if (voxelFormat) {
       std::vector<vox::Rgb8> colors;
       if (*voxelFormat == vox::VoxelFormat::MagicaVoxel && color != vox::ColorMode::None)
-        colors = vox::occupiedCellColors(grid, self.scene(), color);
+        colors =
+            vox::occupiedCellColors(grid, self.scene(), color, 0, [&](double f) { return interrupt.poll(0.3 * f); });
       report = vox::writeVoxelFile(*path, *voxelFormat, grid, colors, poll);
     } else {
-      const vox::VoxelMesh mesh = vox::buildVoxelMesh(grid, self.scene(), faces, color);
+      const vox::VoxelMesh mesh = vox::buildVoxelMesh(grid, self.scene(), faces, color, nullptr,
+                                                      [&](double f) { return interrupt.poll(0.6 * f); });
       poll(0.6);
       vox::writeVoxelMesh(*path, mesh, !ascii);
     }

@@ -27,9 +27,10 @@ struct Source {
   std::string name;   // the path, or "<arrays>"
   std::string label;  // what messages start with: "" for voxelize's source, "sources[i]: " in a batch
 
-  const vox::Scene& load() {
+  // `poll`: Interrupt::poll, asked while the importer parses (a few hundred MB of OBJ take seconds).
+  const vox::Scene& load(const std::function<bool(double)>& poll) {
     if (path) {
-      scene = vox::loadScene(*path);
+      scene = vox::loadScene(*path, poll);
       path.reset();
     }
     return scene;
@@ -189,7 +190,7 @@ std::shared_ptr<PyGrid> voxelize(const py::object& source, const py::object& res
   vo.progress = [&](double f) { return interrupt.poll(voxelizeShare * f); };
   vox::FillReport report;
   vox::Grid grid = runLong(interrupt, nThreads, [&] {
-    const vox::Scene& scene = src.load();
+    const vox::Scene& scene = src.load([&](double) { return interrupt.poll(0); });
     if (request.pitch) applyPitch(*request.pitch, scene, vo);
     return namedAfter(src, [&] {
       if (sdfHalfWidth) vo = vox::withCubicCells(scene, vo);  // as vox-voxelize --sdf: a level set's cubic cells
@@ -240,7 +241,7 @@ py::array_t<double> denseSdf(const py::object& source, const py::object& resolut
   vo.progress = [&](double f) { return interrupt.poll(0.2 * f); };
   std::array<uint32_t, 3> gridDims{};
   std::vector<double> field = runLong(interrupt, nThreads, [&] {
-    const vox::Scene& scene = src.load();
+    const vox::Scene& scene = src.load([&](double) { return interrupt.poll(0); });
     if (request.pitch) applyPitch(*request.pitch, scene, vo);
     return namedAfter(src, [&] {
       vo = vox::withCubicCells(scene, vo);
@@ -338,7 +339,8 @@ py::object voxelizeBatch(const py::object& sources, const py::object& resolution
       if (interrupt.cancelled()) return;
       Source& src = srcs[b];
       vox::Grid g = namedAfter(src, [&] {
-        const vox::Scene& scene = src.load();
+        const vox::Scene& scene =
+            src.load([&](double) { return interrupt.poll(double(done.load()) / double(srcs.size())); });
         vox::VoxelizeOptions vo;
         vo.method = m;
         vo.memoryLimitBytes = budget;

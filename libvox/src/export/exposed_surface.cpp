@@ -189,14 +189,15 @@ struct BrickSet {
   }
 };
 
-BrickSet buildBricks(const Voxels& vox, const std::array<uint32_t, 3>& dims) {
+BrickSet buildBricks(const Voxels& vox, const std::array<uint32_t, 3>& dims, ExportProgress& progress) {
   struct Entry {
     uint64_t brick;
     uint32_t local;
     uint32_t color;
   };
-  std::vector<Entry> entries(vox.keys.size());
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, entries.size()), [&](const tbb::blocked_range<size_t>& r) {
+  std::vector<Entry> entries;
+  progress.resize(entries, vox.keys.size());
+  progress.parallelFor(entries.size(), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t v = r.begin(); v != r.end(); ++v) {
       const auto ijk = cellIndex(dims, vox.keys[v]);
       entries[v] = {brickKey(ijk[0] >> kBrickBits, ijk[1] >> kBrickBits, ijk[2] >> kBrickBits),
@@ -208,14 +209,19 @@ BrickSet buildBricks(const Voxels& vox, const std::array<uint32_t, 3>& dims) {
   });
   // The voxel list's estimate (voxel_mesh.cpp) covers the entries and colours; bricks are per 8^3 block touched, up
   // to one per voxel when they are scattered, so they are counted and checked before they are made.
+  progress.check();  // the sort cannot stop inside: 0.02 s for the bunny at 512^3 (a million voxels)
   uint64_t nBricks = 0;
-  for (size_t v = 0; v < entries.size(); ++v) nBricks += v == 0 || entries[v].brick != entries[v - 1].brick;
+  for (size_t v = 0; v < entries.size(); ++v) {
+    progress.step(v, entries.size());
+    nBricks += v == 0 || entries[v].brick != entries[v - 1].brick;
+  }
   requireMemory(saturatingMul(nBricks, sizeof(Brick) + kHashEntryBytes), "voxel mesh",
                 std::to_string(nBricks) + " bricks of 8^3 cells");
   BrickSet set;
   set.bricks.reserve(nBricks);
-  set.colors.resize(entries.size());
+  progress.resize(set.colors, entries.size());
   for (size_t v = 0; v < entries.size(); ++v) {
+    progress.step(v, entries.size());
     if (set.bricks.empty() || set.bricks.back().key != entries[v].brick) {
       set.bricks.push_back({});
       set.bricks.back().key = entries[v].brick;
@@ -226,7 +232,10 @@ BrickSet buildBricks(const Voxels& vox, const std::array<uint32_t, 3>& dims) {
     set.colors[v] = entries[v].color;
   }
   set.index.reserve(set.bricks.size() * 2);
-  for (uint32_t b = 0; b < set.bricks.size(); ++b) set.index.emplace(set.bricks[b].key, b);
+  for (uint32_t b = 0; b < set.bricks.size(); ++b) {
+    progress.step(b, set.bricks.size());
+    set.index.emplace(set.bricks[b].key, b);
+  }
   return set;
 }
 
@@ -331,12 +340,13 @@ struct WorkBricks {
   std::unordered_map<uint64_t, uint32_t> index;  // key -> position in keys
 };
 
-WorkBricks workBricks(const BrickSet& set) {
+WorkBricks workBricks(const BrickSet& set, ExportProgress& progress) {
   requireMemory(saturatingMul(set.bricks.size(), 8 * (sizeof(uint64_t) + kHashEntryBytes)), "voxel mesh",
                 "the lattice bricks around " + std::to_string(set.bricks.size()) + " bricks");
   WorkBricks work;
   work.keys.reserve(set.bricks.size() * 8);
   for (const Brick& b : set.bricks) {
+    progress.step(work.keys.size() / 8, set.bricks.size());
     const auto c = brickCoords(b.key);
     for (int d = 0; d < 8; ++d)
       work.keys.push_back(
@@ -345,7 +355,10 @@ WorkBricks workBricks(const BrickSet& set) {
   tbb::parallel_sort(work.keys.begin(), work.keys.end());
   work.keys.erase(std::unique(work.keys.begin(), work.keys.end()), work.keys.end());
   work.index.reserve(work.keys.size() * 2);
-  for (uint32_t w = 0; w < work.keys.size(); ++w) work.index.emplace(work.keys[w], w);
+  for (uint32_t w = 0; w < work.keys.size(); ++w) {
+    progress.step(w, work.keys.size());
+    work.index.emplace(work.keys[w], w);
+  }
   return work;
 }
 
@@ -361,15 +374,16 @@ struct VertexNumbering {
   }
 };
 
-VertexNumbering numberVertices(const BrickSet& set, const WorkBricks& work, const PointTables& tables) {
+VertexNumbering numberVertices(const BrickSet& set, const WorkBricks& work, const PointTables& tables,
+                               ExportProgress& progress) {
   const size_t nWork = work.keys.size();
   requireMemory(saturatingMul(nWork, sizeof(std::array<uint16_t, 512>) + sizeof(uint64_t)), "voxel mesh",
                 "the vertex numbers of " + std::to_string(nWork) + " lattice bricks");
   VertexNumbering num;
-  num.firstLocal.resize(nWork);
+  progress.resize(num.firstLocal, nWork);
   num.base.assign(nWork + 1, 0);
   std::atomic<uint64_t> squares{0};
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nWork), [&](const tbb::blocked_range<size_t>& r) {
+  progress.parallelFor(nWork, [&](const tbb::blocked_range<size_t>& r) {
     Pad pad;
     uint64_t rangeSquares = 0;
     for (size_t w = r.begin(); w != r.end(); ++w) {
@@ -482,28 +496,35 @@ void placeVertices(size_t w, const VertexNumbering& num, const Lattice& lat, con
 }
 
 // The lists of squares one after another, in order, each freed once copied.
-std::vector<Square> concatenate(std::vector<std::vector<Square>>& lists) {
+std::vector<Square> concatenate(std::vector<std::vector<Square>>& lists, ExportProgress& progress) {
   std::vector<size_t> offset(lists.size() + 1, 0);
   for (size_t w = 0; w < lists.size(); ++w) offset[w + 1] = offset[w] + lists[w].size();
-  std::vector<Square> all(offset.back());
-  tbb::parallel_for(size_t(0), lists.size(), [&](size_t w) {
-    std::copy(lists[w].begin(), lists[w].end(), all.begin() + ptrdiff_t(offset[w]));
-    std::vector<Square>().swap(lists[w]);
+  std::vector<Square> all;
+  progress.resize(all, offset.back());
+  progress.parallelFor(lists.size(), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t w = r.begin(); w != r.end(); ++w) {
+      std::copy(lists[w].begin(), lists[w].end(), all.begin() + ptrdiff_t(offset[w]));
+      std::vector<Square>().swap(lists[w]);
+    }
   });
   return all;
 }
 
 }  // namespace
 
-ExposedSurface buildExposed(const Voxels& vox, const Lattice& lat) {
+ExposedSurface buildExposed(const Voxels& vox, const Lattice& lat, ExportProgress& progress) {
   const PointTables& tables = pointTables();
   for (int a = 0; a < 3; ++a)
     if (lat.dims[a] >= (uint32_t(1) << (kKeyBits + kBrickBits)) - 2 * kBrick)
       fail<LimitError>("voxel mesh: grid dimension ", lat.dims[a], " too large for export");
-  const BrickSet set = buildBricks(vox, lat.dims);
-  const WorkBricks work = workBricks(set);
+  // The shares of the phases: about their times for the bunny at 512^3.
+  progress.phase(0, 0.2);
+  const BrickSet set = buildBricks(vox, lat.dims, progress);
+  progress.phase(0.2, 0.25);
+  const WorkBricks work = workBricks(set, progress);
   const size_t nWork = work.keys.size();
-  const VertexNumbering num = numberVertices(set, work, tables);
+  progress.phase(0.25, 0.55);
+  const VertexNumbering num = numberVertices(set, work, tables, progress);
 
   requireMemory(saturatingMul(num.base[nWork], sizeof(Vec3) + 1), "voxel mesh",
                 std::to_string(num.base[nWork]) + " vertices");
@@ -513,10 +534,11 @@ ExposedSurface buildExposed(const Voxels& vox, const Lattice& lat) {
   requireMemory(saturatingMul(num.squares, 2 * sizeof(Square)), "voxel mesh",
                 std::to_string(num.squares) + " exposed squares");
   ExposedSurface out;
-  out.positions.resize(num.base[nWork]);
-  out.split.resize(num.base[nWork]);
+  progress.resize(out.positions, num.base[nWork]);
+  progress.resize(out.split, num.base[nWork]);
   std::vector<std::vector<Square>> perBrick(nWork);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nWork), [&](const tbb::blocked_range<size_t>& r) {
+  progress.phase(0.55, 0.9);
+  progress.parallelFor(nWork, [&](const tbb::blocked_range<size_t>& r) {
     Pad pad;
     for (size_t w = r.begin(); w != r.end(); ++w) {
       const auto bc = brickCoords(work.keys[w]);
@@ -533,19 +555,20 @@ ExposedSurface buildExposed(const Voxels& vox, const Lattice& lat) {
       brickSquares(set.bricks[occIt->second], set, pad, origin, vertexId, perBrick[w]);
     }
   });
-  out.squares = concatenate(perBrick);
+  progress.phase(0.9, 1);
+  out.squares = concatenate(perBrick, progress);
   VOX_CHECK(out.squares.size() == num.squares);
   return out;
 }
 
-VoxelMesh exposedMesh(ExposedSurface&& surface, bool colored) {
+VoxelMesh exposedMesh(ExposedSurface&& surface, bool colored, ExportProgress& progress) {
   VoxelMesh mesh;
   mesh.positions = std::move(surface.positions);
   const size_t n = surface.squares.size();
-  mesh.faceStart.resize(n + 1);
-  mesh.faceVertices.resize(4 * n);
-  if (colored) mesh.faceColors.resize(n);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const tbb::blocked_range<size_t>& r) {
+  progress.resize(mesh.faceStart, n + 1);
+  progress.resize(mesh.faceVertices, 4 * n);
+  if (colored) progress.resize(mesh.faceColors, n);
+  progress.parallelFor(n, [&](const tbb::blocked_range<size_t>& r) {
     for (size_t f = r.begin(); f != r.end(); ++f) {
       const Square& s = surface.squares[f];
       // (u, v) axes are (axis+1, axis+2): counter-clockwise about +axis, reversed for faces looking down the axis.

@@ -65,19 +65,25 @@ struct PlaneBuckets {
   std::vector<size_t> planes;  // the planes holding squares
 };
 
-PlaneBuckets bucketByPlane(const std::vector<Square>& sq, const std::array<uint32_t, 3>& dims) {
+PlaneBuckets bucketByPlane(const std::vector<Square>& sq, const std::array<uint32_t, 3>& dims,
+                           ExportProgress& progress) {
   std::array<size_t, 4> axisBase{};
   for (int a = 0; a < 3; ++a) axisBase[a + 1] = axisBase[a] + 2 * (size_t(dims[a]) + 1);
   const size_t nPlanes = axisBase[3];
   auto planeOf = [&](const Square& s) { return axisBase[s.axis] + 2 * size_t(s.plane) + s.positive; };
   PlaneBuckets out;
   out.planeStart.assign(nPlanes + 1, 0);
-  for (const Square& s : sq) ++out.planeStart[planeOf(s) + 1];
+  for (size_t i = 0; i < sq.size(); ++i) {
+    progress.step(i, 2 * sq.size());
+    ++out.planeStart[planeOf(sq[i]) + 1];
+  }
   for (size_t p = 0; p < nPlanes; ++p) out.planeStart[p + 1] += out.planeStart[p];
-  out.order.resize(sq.size());
+  progress.resize(out.order, sq.size());
   std::vector<uint32_t> cursor(out.planeStart.begin(), out.planeStart.end() - 1);
-  for (uint32_t i = 0; i < sq.size(); ++i)
+  for (uint32_t i = 0; i < sq.size(); ++i) {
+    progress.step(sq.size() + i, 2 * sq.size());
     out.order[cursor[planeOf(sq[i])]++] = {(uint64_t(sq[i].v) << 32) | sq[i].u, sq[i].color, i};
+  }
   for (size_t p = 0; p < nPlanes; ++p)
     if (out.planeStart[p + 1] > out.planeStart[p]) out.planes.push_back(p);
   return out;
@@ -158,18 +164,27 @@ PlanePolygons mergePlane(PlaneEntry* const e, size_t n, const std::vector<Square
 // two faces), and dropping them leaves no T-junction. Split lattice points stay: where two sheets run along the same
 // lattice line (two voxels meeting along a row of edges), dropping their vertices would give both sheets the same
 // long edge, with four faces.
-std::vector<uint32_t> keptVertexIds(const std::vector<uint8_t>& split, const std::vector<PlanePolygons>& outs) {
+std::vector<uint32_t> keptVertexIds(const std::vector<uint8_t>& split, const std::vector<PlanePolygons>& outs,
+                                    ExportProgress& progress) {
   const size_t nv = split.size();
   std::vector<std::atomic<uint8_t>> keep(nv);
-  for (size_t v = 0; v < nv; ++v)
+  for (size_t v = 0; v < nv; ++v) {
+    progress.step(v, 2 * nv);
     if (split[v]) keep[v].store(1, std::memory_order_relaxed);
-  tbb::parallel_for(size_t(0), outs.size(), [&](size_t pi) {
-    const PlanePolygons& po = outs[pi];
-    for (size_t k = 0; k < po.verts.size(); ++k)
-      if (po.corner[k]) keep[po.verts[k]].store(1, std::memory_order_relaxed);
+  }
+  progress.parallelFor(outs.size(), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t pi = r.begin(); pi != r.end(); ++pi) {
+      const PlanePolygons& po = outs[pi];
+      for (size_t k = 0; k < po.verts.size(); ++k)
+        if (po.corner[k]) keep[po.verts[k]].store(1, std::memory_order_relaxed);
+    }
   });
-  std::vector<uint32_t> newId(nv + 1, 0);
-  for (size_t v = 0; v < nv; ++v) newId[v + 1] = newId[v] + keep[v].load(std::memory_order_relaxed);
+  std::vector<uint32_t> newId;
+  progress.resize(newId, nv + 1);
+  for (size_t v = 0; v < nv; ++v) {
+    progress.step(nv + v, 2 * nv);
+    newId[v + 1] = newId[v] + keep[v].load(std::memory_order_relaxed);
+  }
   return newId;
 }
 
@@ -211,48 +226,63 @@ void planeFaces(PlanePolygons& po, const std::vector<uint32_t>& newId, const std
 
 // The planes' faces one after another into `mesh` (faceStart, faceVertices, faceColors when colored).
 void gatherFaces(const std::vector<PlanePolygons>& outs, const std::vector<std::vector<uint32_t>>& kept, bool colored,
-                 VoxelMesh& mesh) {
+                 VoxelMesh& mesh, ExportProgress& progress) {
   std::vector<size_t> faceOffset(outs.size() + 1, 0), vertOffset(outs.size() + 1, 0);
   for (size_t pi = 0; pi < outs.size(); ++pi) {
     faceOffset[pi + 1] = faceOffset[pi] + outs[pi].colors.size();
     vertOffset[pi + 1] = vertOffset[pi] + kept[pi].size();
   }
-  mesh.faceStart.resize(faceOffset.back() + 1);
-  mesh.faceVertices.resize(vertOffset.back());
-  if (colored) mesh.faceColors.resize(faceOffset.back());
+  progress.resize(mesh.faceStart, faceOffset.back() + 1);
+  progress.resize(mesh.faceVertices, vertOffset.back());
+  if (colored) progress.resize(mesh.faceColors, faceOffset.back());
   mesh.faceStart[0] = 0;
-  tbb::parallel_for(size_t(0), outs.size(), [&](size_t pi) {
-    std::copy(kept[pi].begin(), kept[pi].end(), mesh.faceVertices.begin() + ptrdiff_t(vertOffset[pi]));
-    for (size_t f = 0; f < outs[pi].colors.size(); ++f) {
-      mesh.faceStart[faceOffset[pi] + f + 1] = uint32_t(vertOffset[pi] + outs[pi].start[f + 1]);
-      if (colored) mesh.faceColors[faceOffset[pi] + f] = unpackColor(outs[pi].colors[f]);
+  progress.parallelFor(outs.size(), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t pi = r.begin(); pi != r.end(); ++pi) {
+      std::copy(kept[pi].begin(), kept[pi].end(), mesh.faceVertices.begin() + ptrdiff_t(vertOffset[pi]));
+      for (size_t f = 0; f < outs[pi].colors.size(); ++f) {
+        mesh.faceStart[faceOffset[pi] + f + 1] = uint32_t(vertOffset[pi] + outs[pi].start[f + 1]);
+        if (colored) mesh.faceColors[faceOffset[pi] + f] = unpackColor(outs[pi].colors[f]);
+      }
     }
   });
 }
 
 }  // namespace
 
-VoxelMesh mergedMesh(ExposedSurface&& surface, const std::array<uint32_t, 3>& dims, bool colored) {
-  PlaneBuckets buckets = bucketByPlane(surface.squares, dims);
+VoxelMesh mergedMesh(ExposedSurface&& surface, const std::array<uint32_t, 3>& dims, bool colored,
+                     ExportProgress& progress) {
+  // The shares of the phases: about their times for the bunny at 512^3.
+  progress.phase(0, 0.15);
+  PlaneBuckets buckets = bucketByPlane(surface.squares, dims, progress);
   std::vector<PlanePolygons> outs(buckets.planes.size());
-  tbb::parallel_for(size_t(0), buckets.planes.size(), [&](size_t pi) {
-    const size_t p = buckets.planes[pi];
-    outs[pi] = mergePlane(buckets.order.data() + buckets.planeStart[p],
-                          buckets.planeStart[p + 1] - buckets.planeStart[p], surface.squares);
+  progress.phase(0.15, 0.55);
+  // One plane a step: a plane holds at most a grid side squared of squares, milliseconds of work.
+  progress.parallelFor(buckets.planes.size(), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t pi = r.begin(); pi != r.end(); ++pi) {
+      const size_t p = buckets.planes[pi];
+      outs[pi] = mergePlane(buckets.order.data() + buckets.planeStart[p],
+                            buckets.planeStart[p + 1] - buckets.planeStart[p], surface.squares);
+    }
   });
   std::vector<Square>().swap(surface.squares);
 
-  const std::vector<uint32_t> newId = keptVertexIds(surface.split, outs);
+  progress.phase(0.55, 0.7);
+  const std::vector<uint32_t> newId = keptVertexIds(surface.split, outs, progress);
   const size_t nv = surface.positions.size();
   VoxelMesh mesh;
-  mesh.positions.resize(newId[nv]);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nv), [&](const tbb::blocked_range<size_t>& r) {
+  progress.resize(mesh.positions, newId[nv]);
+  progress.phase(0.7, 0.75);
+  progress.parallelFor(nv, [&](const tbb::blocked_range<size_t>& r) {
     for (size_t v = r.begin(); v != r.end(); ++v)
       if (newId[v + 1] > newId[v]) mesh.positions[newId[v]] = surface.positions[v];
   });
   std::vector<std::vector<uint32_t>> kept(outs.size());
-  tbb::parallel_for(size_t(0), outs.size(), [&](size_t pi) { planeFaces(outs[pi], newId, mesh.positions, kept[pi]); });
-  gatherFaces(outs, kept, colored, mesh);
+  progress.phase(0.75, 0.9);
+  progress.parallelFor(outs.size(), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t pi = r.begin(); pi != r.end(); ++pi) planeFaces(outs[pi], newId, mesh.positions, kept[pi]);
+  });
+  progress.phase(0.9, 1);
+  gatherFaces(outs, kept, colored, mesh, progress);
   return mesh;
 }
 

@@ -74,29 +74,37 @@ uint32_t majorityMaterialColor(const Grid& grid, const Scene& scene, size_t cell
 
 // The packed colour of each occupied cell (kNoColor for ColorMode::None); shared by the meshes and by
 // occupiedCellColors (the voxel formats), so a cell has one colour in every export. Count reads only cellStart,
-// against maxCount (0: the grid's own largest count).
-std::vector<uint32_t> occupiedColors(const Grid& grid, const Scene& scene, ColorMode mode, uint32_t maxCount = 0) {
+// against maxCount (0: the grid's own largest count). Reports to `progress` over its current phase.
+std::vector<uint32_t> occupiedColors(const Grid& grid, const Scene& scene, ColorMode mode, uint32_t maxCount,
+                                     ExportProgress& progress) {
   const size_t nOcc = grid.cellKeys.size();
   if (grid.cellStart.size() != nOcc + 1 || (mode != ColorMode::Count && grid.cellStart.back() > grid.primIds.size()))
     fail<InputError>("grid: inconsistent cell table (", nOcc, " cells, ", grid.cellStart.size(), " offsets)");
-  std::vector<uint32_t> occColor(nOcc, kNoColor);
+  static_assert(kNoColor == 0);  // what resize gives
+  std::vector<uint32_t> occColor;
+  progress.resize(occColor, nOcc);
   if (mode == ColorMode::Count) {
     if (maxCount == 0) maxCount = largestCellCount(grid);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, nOcc), [&](const tbb::blocked_range<size_t>& r) {
+    progress.parallelFor(nOcc, [&](const tbb::blocked_range<size_t>& r) {
       for (size_t c = r.begin(); c != r.end(); ++c)
         occColor[c] = packColor(toRgb8(countColor(uint32_t(grid.cellStart[c + 1] - grid.cellStart[c]), maxCount)));
     });
   } else if (mode == ColorMode::Material) {
     std::mutex errorMutex;
     std::exception_ptr error;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, nOcc), [&](const tbb::blocked_range<size_t>& r) {
+    const auto paint = [&](const tbb::blocked_range<size_t>& r) {
       try {
         for (size_t c = r.begin(); c != r.end(); ++c) occColor[c] = majorityMaterialColor(grid, scene, c);
       } catch (...) {
         std::lock_guard lock(errorMutex);
         if (!error) error = std::current_exception();
       }
-    });
+    };
+    try {
+      progress.parallelFor(nOcc, paint);
+    } catch (const Error&) {
+      if (!error) throw;  // cancelled; a bad cell found meanwhile is the better message
+    }
     if (error) std::rethrow_exception(error);
   }
   return occColor;
@@ -110,7 +118,9 @@ std::vector<uint32_t> occupiedColors(const Grid& grid, const Scene& scene, Color
 constexpr uint64_t kSurfaceBytesPerVoxel = 12 + 16 + 4;
 constexpr uint64_t kCubeBytesPerVoxel = 12 + 8 * sizeof(Vec3) + 36 * 4 + 12 * 4 + 12 * 3;
 
-Voxels gatherVoxels(const Grid& grid, const Scene& scene, ColorMode mode, uint64_t bytesPerVoxel) {
+// The voxels and their colours: the colours are [0, 0.8] of `progress`'s range, the merge the rest.
+Voxels gatherVoxels(const Grid& grid, const Scene& scene, ColorMode mode, uint64_t bytesPerVoxel,
+                    ExportProgress& progress) {
   const size_t nOcc = grid.cellKeys.size();
   if (grid.cellStart.size() != nOcc + 1 || grid.cellStart.back() > grid.primIds.size())
     fail<InputError>("grid: inconsistent cell table (", nOcc, " cells, ", grid.cellStart.size(), " offsets)");
@@ -120,7 +130,11 @@ Voxels gatherVoxels(const Grid& grid, const Scene& scene, ColorMode mode, uint64
   requireMemory(saturatingMul(voxels, bytesPerVoxel), "voxel mesh",
                 "a list of " + describeCount(voxels) + " voxels at " + std::to_string(bytesPerVoxel) + " bytes each");
 
-  const std::vector<uint32_t> occColor = occupiedColors(grid, scene, mode);
+  const std::vector<uint32_t> occColor = [&] {
+    progress.phase(0, 0.8);
+    return occupiedColors(grid, scene, mode, 0, progress);
+  }();
+  progress.phase(0.8, 1);
 
   // Merge occupied keys and solid runs; a cell in both is drawn once, with its occupied colour.
   const uint32_t solid = mode == ColorMode::None ? kNoColor : packColor(kSolidCellColor);
@@ -134,12 +148,14 @@ Voxels gatherVoxels(const Grid& grid, const Scene& scene, ColorMode mode, uint64
         v.keys.push_back(grid.cellKeys[a]);
         v.colors.push_back(occColor[a]);
       }
+      progress.step(v.keys.size(), voxels);
       if (a < nOcc && grid.cellKeys[a] == key) continue;  // occupied wins; pushed by the loop above next time
       v.keys.push_back(key);
       v.colors.push_back(solid);
     }
   }
   for (; a < nOcc; ++a) {
+    progress.step(a, nOcc);
     v.keys.push_back(grid.cellKeys[a]);
     v.colors.push_back(occColor[a]);
   }
@@ -149,19 +165,19 @@ Voxels gatherVoxels(const Grid& grid, const Scene& scene, ColorMode mode, uint64
 // ---------------------------------------------------------------------------------------------------------------
 // FaceMode::All
 
-VoxelMesh buildCubes(const Voxels& vox, const Lattice& lat, bool colored) {
+VoxelMesh buildCubes(const Voxels& vox, const Lattice& lat, bool colored, ExportProgress& progress) {
   const size_t n = vox.keys.size();
   checkVertexCount(uint64_t(n) * 8);
   VoxelMesh mesh;
-  mesh.positions.resize(n * 8);
-  mesh.faceVertices.resize(n * 36);
-  mesh.faceStart.resize(n * 12 + 1);
-  if (colored) mesh.faceColors.resize(n * 12);
+  progress.resize(mesh.positions, n * 8);
+  progress.resize(mesh.faceVertices, n * 36);
+  progress.resize(mesh.faceStart, n * 12 + 1);
+  if (colored) progress.resize(mesh.faceColors, n * 12);
   // Corner c of the cube is (c&1, c>>1&1, c>>2&1); the triangles are counter-clockwise seen from outside.
   static constexpr uint8_t kTris[12][3] = {{0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5},   // -x, +x
                                            {0, 1, 5}, {0, 5, 4}, {2, 6, 7}, {2, 7, 3},   // -y, +y
                                            {0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}};  // -z, +z
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const tbb::blocked_range<size_t>& r) {
+  progress.parallelFor(n, [&](const tbb::blocked_range<size_t>& r) {
     for (size_t v = r.begin(); v != r.end(); ++v) {
       const auto ijk = cellIndex(lat.dims, vox.keys[v]);
       for (uint32_t c = 0; c < 8; ++c)
@@ -178,22 +194,30 @@ VoxelMesh buildCubes(const Voxels& vox, const Lattice& lat, bool colored) {
 
 }  // namespace
 
-VoxelMesh buildVoxelMesh(const Grid& grid, const Scene& scene, FaceMode faces, ColorMode color, VoxelMeshStats* stats) {
+VoxelMesh buildVoxelMesh(const Grid& grid, const Scene& scene, FaceMode faces, ColorMode color, VoxelMeshStats* stats,
+                         const std::function<bool(double)>& progress) {
   const auto start = std::chrono::steady_clock::now();
+  ExportProgress report(progress, "voxel mesh");
+  // The shares of the phases: about their times for the bunny at 512^3 with colours.
+  report.within(0, 0.25);
   const Voxels vox =
-      gatherVoxels(grid, scene, color, faces == FaceMode::All ? kCubeBytesPerVoxel : kSurfaceBytesPerVoxel);
+      gatherVoxels(grid, scene, color, faces == FaceMode::All ? kCubeBytesPerVoxel : kSurfaceBytesPerVoxel, report);
   const Lattice lat{grid.bounds, grid.dims};
   const bool colored = color != ColorMode::None;
   VoxelMesh mesh;
   size_t exposed = 0;
   if (faces == FaceMode::All) {
-    mesh = buildCubes(vox, lat, colored);
+    report.within(0.25, 1);
+    mesh = buildCubes(vox, lat, colored, report);
   } else {
-    ExposedSurface surface = buildExposed(vox, lat);
+    report.within(0.25, 0.7);
+    ExposedSurface surface = buildExposed(vox, lat, report);
     exposed = surface.squares.size();
-    mesh = faces == FaceMode::Exposed ? exposedMesh(std::move(surface), colored)
-                                      : mergedMesh(std::move(surface), grid.dims, colored);
+    report.within(0.7, 1);
+    mesh = faces == FaceMode::Exposed ? exposedMesh(std::move(surface), colored, report)
+                                      : mergedMesh(std::move(surface), grid.dims, colored, report);
   }
+  report.check();
   if (stats) {
     stats->voxels = vox.keys.size();
     stats->exposedFaces = exposed;
@@ -270,16 +294,27 @@ std::vector<Rgb8> dominantVertexColors(const VoxelMesh& mesh) {
   return colors;
 }
 
-VoxelMesh triangulateVoxelMesh(const VoxelMesh& mesh) {
+VoxelMesh triangulateVoxelMesh(const VoxelMesh& mesh, const std::function<bool(double)>& progress) {
+  ExportProgress report(progress, "triangulation");
   const size_t nf = mesh.faceCount();
-  std::vector<size_t> triStart(nf + 1, 0);
-  for (size_t f = 0; f < nf; ++f) triStart[f + 1] = triStart[f] + (mesh.faceSize(f) >= 3 ? mesh.faceSize(f) - 2 : 0);
+  std::vector<size_t> triStart;
+  report.phase(0, 0.1);
+  report.resize(triStart, nf + 1);
+  for (size_t f = 0; f < nf; ++f) {
+    report.step(f, nf);
+    triStart[f + 1] = triStart[f] + (mesh.faceSize(f) >= 3 ? mesh.faceSize(f) - 2 : 0);
+  }
+  report.phase(0.1, 1);
   VoxelMesh out;
-  out.positions = mesh.positions;
-  out.faceVertices.resize(3 * triStart[nf]);
-  out.faceStart.resize(triStart[nf] + 1);
-  if (mesh.hasColors()) out.faceColors.resize(triStart[nf]);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nf), [&](const tbb::blocked_range<size_t>& r) {
+  report.resize(out.positions, mesh.positions.size());
+  report.resize(out.faceVertices, 3 * triStart[nf]);
+  report.resize(out.faceStart, triStart[nf] + 1);
+  if (mesh.hasColors()) report.resize(out.faceColors, triStart[nf]);
+  report.parallelFor(mesh.positions.size(), [&](const tbb::blocked_range<size_t>& r) {
+    std::copy(mesh.positions.begin() + ptrdiff_t(r.begin()), mesh.positions.begin() + ptrdiff_t(r.end()),
+              out.positions.begin() + ptrdiff_t(r.begin()));
+  });
+  report.parallelFor(nf, [&](const tbb::blocked_range<size_t>& r) {
     std::vector<uint32_t> poly, tris;
     for (size_t f = r.begin(); f != r.end(); ++f) {
       poly.assign(mesh.faceVertices.begin() + mesh.faceStart[f], mesh.faceVertices.begin() + mesh.faceStart[f + 1]);
@@ -323,11 +358,18 @@ uint32_t largestCellCount(const Grid& grid) {
   return n;
 }
 
-std::vector<Rgb8> occupiedCellColors(const Grid& grid, const Scene& scene, ColorMode color, uint32_t maxCount) {
+std::vector<Rgb8> occupiedCellColors(const Grid& grid, const Scene& scene, ColorMode color, uint32_t maxCount,
+                                     const std::function<bool(double)>& progress) {
   if (color == ColorMode::None) return {};
-  const std::vector<uint32_t> packed = occupiedColors(grid, scene, color, maxCount);
+  ExportProgress report(progress, "cell colours");
+  report.within(0, 0.9);
+  const std::vector<uint32_t> packed = occupiedColors(grid, scene, color, maxCount, report);
+  report.within(0.9, 1);
   std::vector<Rgb8> colors(packed.size());
-  for (size_t c = 0; c < packed.size(); ++c) colors[c] = unpackColor(packed[c]);
+  for (size_t c = 0; c < packed.size(); ++c) {
+    report.step(c, packed.size());
+    colors[c] = unpackColor(packed[c]);
+  }
   return colors;
 }
 

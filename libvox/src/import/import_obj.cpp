@@ -110,8 +110,10 @@ std::map<std::string, uint32_t> loadLibraries(const std::string& objPath, const 
 
 }  // namespace
 
-Scene importObj(const std::string& path) {
-  const ObjData obj = parseObj(readTextFile(path, "OBJ file", kMaxObjFileBytes).view(), path);
+Scene importObj(const std::string& path, const std::function<bool(double)>& progress) {
+  ImportProgress report(progress, path);
+  const ObjData obj =
+      parseObj(readTextFile(path, "OBJ file", kMaxObjFileBytes, &report).view(), path, kObjChunkBytes, &report);
   Scene scene;
   scene.warnings = obj.warnings;
   const std::map<std::string, uint32_t> byName = loadLibraries(path, obj, scene);
@@ -136,6 +138,7 @@ Scene importObj(const std::string& path) {
   std::map<uint32_t, uint32_t> cloneOf;
   bool warnedNoTexcoords = false;
   for (size_t i = 0; i < obj.triangles.size(); ++i) {
+    report.step(i, 0.9 + 0.1 * double(i) / double(obj.triangles.size()));
     const auto& f = obj.triangles[i];
     uint32_t m = obj.triangleMaterial[i] == kNoObjMaterial ? defaultMaterial : slot[obj.triangleMaterial[i]];
     usesDefault |= m == defaultMaterial;

@@ -10,7 +10,7 @@
 
 namespace vox {
 
-Scene loadScene(const std::string& path) {
+Scene loadScene(const std::string& path, const std::function<bool(double)>& progress) {
   std::string ext = std::filesystem::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   // Before any importer opens it: a folder named d.txt must not import as an empty scene, and a FIFO would block.
@@ -19,11 +19,11 @@ Scene loadScene(const std::string& path) {
   if (ext == ".txt")
     scene = importCourseScene(path);
   else if (ext == ".obj")
-    scene = importObj(path);
+    scene = importObj(path, progress);
   else if (ext == ".gltf" || ext == ".glb")
     scene = importGltf(path);
   else if (ext == ".ply")
-    scene = importPly(path);
+    scene = importPly(path, progress);
   else
     fail<InputError>(path, ": unknown scene format '", ext, "' (expected .txt, .obj, .gltf, .glb or .ply)");
   validateScene(scene, path);

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <unordered_map>
 #include <utility>
 
@@ -124,7 +125,7 @@ void joinTriangleTexcoords(std::vector<ObjChunkResult>& parts, ObjData& out) {
 
 }  // namespace
 
-std::vector<ObjChunk> cutObjText(std::string_view text, size_t chunkBytes) {
+std::vector<ObjChunk> cutObjText(std::string_view text, size_t chunkBytes, ImportProgress* progress) {
   std::vector<ObjChunk> chunks;
   size_t begin = 0;
   while (begin < text.size()) {
@@ -138,7 +139,13 @@ std::vector<ObjChunk> cutObjText(std::string_view text, size_t chunkBytes) {
     begin = end;
   }
   std::vector<ChunkCounts> counts(chunks.size());
-  tbb::parallel_for(size_t(0), chunks.size(), [&](size_t k) { counts[k] = countChunk(chunks[k].text); });
+  std::atomic<size_t> counted{0};
+  tbb::parallel_for(size_t(0), chunks.size(), [&](size_t k) {
+    if (progress && progress->cancelled()) return;
+    counts[k] = countChunk(chunks[k].text);
+    if (progress) progress->report(0.1 + 0.1 * double(++counted) / double(chunks.size()));
+  });
+  if (progress) progress->check();
   for (size_t k = 0; k < chunks.size(); ++k) {
     chunks[k].vertices = counts[k].vertices;
     chunks[k].triangles = counts[k].triangles;

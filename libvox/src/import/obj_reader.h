@@ -29,6 +29,7 @@
 #include "vox/core/huge_pages.h"
 #include "vox/core/math.h"
 #include "vox/core/scene.h"
+#include "import/import_progress.h"
 
 namespace vox {
 
@@ -65,14 +66,17 @@ std::string quotedWord(std::string_view word);
 
 // Reads a whole file into memory on huge pages through readInputBytes (input_file.h: regular files only, within
 // the memory budget). Throws InputError naming `path` when it cannot be read or is larger than `maxBytes`.
-HugeBuffer readTextFile(const std::string& path, const char* what, size_t maxBytes);
+// Reports to `progress` (when given) from 0 to 0.1 of the read.
+HugeBuffer readTextFile(const std::string& path, const char* what, size_t maxBytes, ImportProgress* progress = nullptr);
 
 // Texts of at least twice this many bytes are read in chunks of about this size, on all threads (obj_chunks.h).
 constexpr size_t kObjChunkBytes = size_t{1} << 19;
 
 // Parses OBJ text; `path` only names the file in messages. Throws InputError "path:line: ..." for the file's first
-// error. The result and the error do not depend on chunkBytes (tests read texts in chunks of single lines).
-ObjData parseObj(std::string_view text, const std::string& path, size_t chunkBytes = kObjChunkBytes);
+// error. The result and the error do not depend on chunkBytes (tests read texts in chunks of single lines). Reports
+// to `progress` (when given) from 0.1 to 0.9 of the read, a chunk at a time.
+ObjData parseObj(std::string_view text, const std::string& path, size_t chunkBytes = kObjChunkBytes,
+                 ImportProgress* progress = nullptr);
 
 // A `map_Kd` of material `material` (an index into parseMtl's result): the file as written, its line, `-clamp on`.
 struct MtlDiffuseMap {

@@ -44,8 +44,10 @@ std::string quotedWord(std::string_view word) {
   return out;
 }
 
-HugeBuffer readTextFile(const std::string& path, const char* what, size_t maxBytes) {
-  return readInputBytes(path, what, maxBytes);  // regular files only, within the limit and the memory budget
+HugeBuffer readTextFile(const std::string& path, const char* what, size_t maxBytes, ImportProgress* progress) {
+  // Regular files only, within the limit and the memory budget.
+  if (!progress) return readInputBytes(path, what, maxBytes);
+  return readInputBytes(path, what, maxBytes, [&](double f) { return progress->report(0.1 * f); });
 }
 
 }  // namespace vox

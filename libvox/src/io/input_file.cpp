@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstdint>
@@ -71,10 +72,22 @@ std::string readInputFile(const std::string& path, const char* what) {
   return bytes;
 }
 
-HugeBuffer readInputBytes(const std::string& path, const char* what, size_t maxBytes) {
+HugeBuffer readInputBytes(const std::string& path, const char* what, size_t maxBytes,
+                          const std::function<bool(double)>& progress) {
   const OpenInput in = openInput(path, what, maxBytes);
   HugeBuffer bytes(in.size);
-  readAll(in, bytes.data(), path);
+  if (!progress) {
+    readAll(in, bytes.data(), path);
+    return bytes;
+  }
+  constexpr size_t kPiece = size_t{32} << 20;
+  for (size_t at = 0; at < in.size; at += kPiece) {
+    const size_t want = std::min(kPiece, in.size - at);
+    const size_t got = std::fread(bytes.data() + at, 1, want, in.file.get());
+    if (std::ferror(in.file.get()) != 0 || got != want)
+      fail<InputError>(path, ": read error after ", at + got, " bytes");
+    if (!progress(double(at + got) / double(in.size))) fail<Error>(path, ": reading cancelled");
+  }
   return bytes;
 }
 

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -42,8 +43,9 @@ inline constexpr Rgb8 kSolidCellColor{153, 153, 153};
 // at `maxCount`, 0 meaning largestCellCount(grid); a piece of a larger grid (a layer of a grid set) passes the whole
 // grid's, so its cells get the whole grid's colours. Count reads only cellStart, so primIds may be empty
 // (LayerCells::KeysAndCounts). Throws InputError like buildVoxelMesh for an inconsistent cell table or a primitive
-// or material out of range.
-std::vector<Rgb8> occupiedCellColors(const Grid& grid, const Scene& scene, ColorMode color, uint32_t maxCount = 0);
+// or material out of range. `progress` as buildVoxelMesh's (Error "cell colours cancelled").
+std::vector<Rgb8> occupiedCellColors(const Grid& grid, const Scene& scene, ColorMode color, uint32_t maxCount = 0,
+                                     const std::function<bool(double)>& progress = {});
 
 // The largest number of primitives in one occupied cell of `grid` (from cellStart only); 0 without cells.
 uint32_t largestCellCount(const Grid& grid);
@@ -89,13 +91,17 @@ struct VoxelMeshStats {
 // colour merge. Memory and time grow with the number of voxels, not with the grid's dimensions. Work is spread over
 // the TBB arena of the caller. Throws InputError when a cell key lies outside the grid or a primitive id or
 // material index is out of range, LimitError when the mesh would need more than 2^32 vertices.
+// `progress` (may be empty) is called with the fraction done in [0, 1], from worker threads and from the calling
+// thread, the latter at least every few milliseconds of work; return false to cancel (throws vox::Error "voxel mesh
+// cancelled").
 VoxelMesh buildVoxelMesh(const Grid& grid, const Scene& scene, FaceMode faces, ColorMode color,
-                         VoxelMeshStats* stats = nullptr);
+                         VoxelMeshStats* stats = nullptr, const std::function<bool(double)>& progress = {});
 
 // A copy of `mesh` with every face split into triangles, without new vertices and without zero-area triangles.
 // Precondition: each face is a triangle, or a planar axis-aligned rectangle whose sides may carry extra collinear
-// vertices (what buildVoxelMesh produces). Colours follow their faces.
-VoxelMesh triangulateVoxelMesh(const VoxelMesh& mesh);
+// vertices (what buildVoxelMesh produces). Colours follow their faces. `progress` as buildVoxelMesh's (Error
+// "triangulation cancelled").
+VoxelMesh triangulateVoxelMesh(const VoxelMesh& mesh, const std::function<bool(double)>& progress = {});
 
 // One colour per vertex for clients that read vertex colours only (Blender's and assimp's PLY importers): the face
 // colour that covers the largest angle around the vertex (ties: the smallest colour, as bytes r, g, b), so that a

@@ -2,14 +2,18 @@
 // All throw InputError with the file name and the place (line, node, accessor) on malformed input.
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "vox/core/scene.h"
 
 namespace vox {
 
-// Dispatches on the extension: .txt (course format), .obj, .gltf/.glb, .ply.
-Scene loadScene(const std::string& path);
+// Dispatches on the extension: .txt (course format), .obj, .gltf/.glb, .ply. `progress` (may be empty) is called
+// with the fraction read while the OBJ and PLY importers parse, from worker threads and from the calling thread, the
+// latter every few milliseconds of parsing; return false to cancel (throws vox::Error "PATH: reading cancelled").
+// The glTF and course formats are read without it (tinygltf parses in one call; course scenes are small).
+Scene loadScene(const std::string& path, const std::function<bool(double)>& progress = {});
 
 // The MIT 6.837 text scene format (grammar in seed-scenes/6837/README.md). TriangleMesh paths are resolved relative
 // to the scene file's folder. Procedural materials (Checkerboard, Noise, Marble, Wood) become their first
@@ -21,8 +25,9 @@ Scene importCourseScene(const std::string& path);
 // diffuse, Ks -> specular, Ns -> exponent, Ni -> indexOfRefraction; faces without a material get a default white
 // one (the last material). `mtllib` files are resolved in the OBJ file's folder: a missing one is a warning, one
 // outside that folder or not a regular file an InputError. Throws InputError "file:line: ..." on a malformed
-// number (NaN, infinity, out of range), an index outside the vertices, or a file over 4 GiB.
-Scene importObj(const std::string& path);
+// number (NaN, infinity, out of range), an index outside the vertices, or a file over 4 GiB. `progress` as
+// loadScene's.
+Scene importObj(const std::string& path, const std::function<bool(double)>& progress = {});
 // glTF 2.0 (.gltf, .glb) through tinygltf: node hierarchy (matrix or TRS), triangle primitives (indexed or not),
 // baseColorFactor, cameras, KHR_lights_punctual. Other primitive modes are skipped with a warning.
 // Scene: the default scene, else scene 0, else every root node. Triangle strips and fans are converted.
@@ -36,6 +41,7 @@ Scene importGltf(const std::string& path);
 // PLY triangle meshes (ASCII and binary), read by libvox itself: coordinates exact (double properties bit for bit),
 // faces fan-triangulated. Throws InputError naming the file and the line (ASCII) or element and byte (binary) on a
 // value that does not fit its declared type, a vertex index out of range, or an element count the file cannot hold.
-Scene importPly(const std::string& path);
+// `progress` as loadScene's.
+Scene importPly(const std::string& path, const std::function<bool(double)>& progress = {});
 
 }  // namespace vox

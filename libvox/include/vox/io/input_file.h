@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 
 // The budget these checks hold reads to, and the quoting their messages use, are core's (other stages use them too);
@@ -21,7 +22,10 @@ std::string readInputFile(const std::string& path, const char* what);
 // The same, into a buffer on huge pages, whole and not zeroed first (huge_buffer.h): for the large texts the
 // importers parse (OBJ, PLY), where the string's page faults and TLB misses cost more than the parse. A file of more
 // than maxBytes is refused before it is read: "PATH: WHAT is N bytes, more than the limit of M bytes".
-HugeBuffer readInputBytes(const std::string& path, const char* what, size_t maxBytes = SIZE_MAX);
+// `progress` (may be empty) gets the fraction read after every 32 MiB; return false to cancel (throws vox::Error
+// "PATH: reading cancelled"): a few hundred MB take tenths of a second, longer than Ctrl-C may wait.
+HugeBuffer readInputBytes(const std::string& path, const char* what, size_t maxBytes = SIZE_MAX,
+                          const std::function<bool(double)>& progress = {});
 
 // Throws InputError unless `path` names a regular file (checked before any importer opens it).
 void requireRegularFile(const std::string& path, const char* what);

@@ -31,6 +31,8 @@ MOMENTS = textwrap.dedent("""
         F = np.loadtxt(f, max_rows=counts[1], usecols=(1, 2, 3), dtype=np.int64)
     grid = libvox.voxelize(path, resolution=64)
     libvox.render(grid, size=(4, 4))  # the trace structure, built on the first render, outside the clock
+    lo, hi = np.array(grid.bounds[0]), np.array(grid.bounds[1])
+    points = np.random.default_rng(1).uniform(lo, hi, size=(300_000, 3))
 
     def call():
         if what == "voxelize":
@@ -39,6 +41,10 @@ MOMENTS = textwrap.dedent("""
             libvox.voxelize(path, resolution=1024, fill=True)
         elif what == "batch":
             libvox.voxelize_batch([(V, F)] * 64, 256)
+        elif what == "sdf":  # the dense signed distance field's rows
+            libvox.sdf(path, resolution=64)
+        elif what == "distance":  # nearest primitives of 300,000 points, signed
+            grid.distance(points)
         else:
             libvox.render(grid, size=(2000, 2000), samples=16)
 
@@ -72,10 +78,10 @@ MOMENTS = textwrap.dedent("""
 """)
 
 
-@pytest.mark.parametrize("what", ["voxelize", "fill", "batch"])
+@pytest.mark.parametrize("what", ["voxelize", "fill", "batch", "sdf", "distance"])
 def test_ctrl_c_within_half_a_second(what):
-    """voxelize of the bunny at 2048^3, with fill at 1024^3, and voxelize_batch of 64 bunnies at 256^3, each
-    interrupted at 10 moments."""
+    """voxelize of the bunny at 2048^3, with fill at 1024^3, voxelize_batch of 64 bunnies at 256^3, libvox.sdf of
+    the bunny at 64^3 and Grid.distance of 300,000 points, each interrupted at 10 moments."""
     proc = subprocess.run([sys.executable, "-c", MOMENTS, what, str(BUNNY_PLY)], capture_output=True, text=True,
                           timeout=300)
     assert proc.returncode == 0, proc.stderr

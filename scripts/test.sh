@@ -3,7 +3,7 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 "$root/scripts/install-deps.sh" --clients
-build=${1:-$root/build}
+build=$(realpath -m "${1:-$root/build}")  # absolute: the Python stage runs from tests/python
 VOX_SEED_DIR=$("$root/scripts/seed-dir.sh")
 export VOX_SEED_DIR
 shift || true

@@ -44,6 +44,15 @@ Vec3 cellCentre(const Grid& grid, uint64_t key) {
   return c;
 }
 
+std::array<std::vector<double>, 3> cellCentresByAxis(const Grid& grid) {
+  std::array<std::vector<double>, 3> centres;
+  for (int a = 0; a < 3; ++a) {
+    centres[a].resize(grid.dims[a]);
+    for (uint32_t i = 0; i < grid.dims[a]; ++i) centres[a][i] = cellCentreOnAxis(grid.bounds, grid.dims, a, i);
+  }
+  return centres;
+}
+
 int64_t findCell(const Grid& grid, uint64_t key) {
   const auto it = std::lower_bound(grid.cellKeys.begin(), grid.cellKeys.end(), key);
   if (it == grid.cellKeys.end() || *it != key) return -1;

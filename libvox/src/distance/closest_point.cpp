@@ -229,4 +229,15 @@ bool insideEllipsoid(const EllipsoidShape& shape, const Vec3& p) {
   return sum < 1;
 }
 
+double squaredDistanceToTriangleWithin(const Triangle& t, const Vec3& normal, const Vec3& p, double bound2) {
+  const double plane = dot(normal, p - t.v[0]);
+  if (plane * plane > bound2 * dot(normal, normal) * (1 + 1e-12)) return INFINITY;
+  return squaredDistanceToTriangle(t.v[0], t.v[1], t.v[2], p);
+}
+
+Box ellipsoidBounds(const EllipsoidShape& shape) {
+  const double big = shape.semi.x;
+  return {shape.center - Vec3{big, big, big}, shape.center + Vec3{big, big, big}};
+}
+
 }  // namespace vox

@@ -23,11 +23,6 @@ double squaredDistanceToBox(const Box& b, const Vec3& p) {
 
 Box unite(const Box& a, const Box& b) { return {minVec(a.lo, b.lo), maxVec(a.hi, b.hi)}; }
 
-Box shapeBox(const EllipsoidShape& s) {
-  const double big = std::max({s.semi.x, s.semi.y, s.semi.z});
-  return {s.center - Vec3{big, big, big}, s.center + Vec3{big, big, big}};
-}
-
 }  // namespace
 
 NearestPrimitive::NearestPrimitive(const Scene& scene) : triangleCount_(uint32_t(scene.triangles.size())) {
@@ -36,7 +31,7 @@ NearestPrimitive::NearestPrimitive(const Scene& scene) : triangleCount_(uint32_t
   std::vector<Box> boxes(n);
   std::vector<Vec3> centroids(n);
   for (size_t p = 0; p < n; ++p) {
-    boxes[p] = p < triangleCount_ ? triangleBounds(scene.triangles[p]) : shapeBox(shapes_[p - triangleCount_]);
+    boxes[p] = p < triangleCount_ ? triangleBounds(scene.triangles[p]) : ellipsoidBounds(shapes_[p - triangleCount_]);
     centroids[p] = (boxes[p].lo + boxes[p].hi) * 0.5;
   }
   ids_.resize(n);
@@ -84,17 +79,11 @@ uint32_t NearestPrimitive::build(uint32_t begin, uint32_t end, std::vector<Vec3>
   return index;
 }
 
-// The squared distance from p to the primitive in `slot`, or infinity when the triangle's plane alone is farther
-// than bound2 (with a margin of 1e-12, so rounding never skips a triangle the answer could be).
+// The squared distance from p to the primitive in `slot`, or infinity when a triangle's plane alone is farther
+// than bound2 (squaredDistanceToTriangleWithin).
 double NearestPrimitive::squaredDistanceTo(uint32_t slot, const Vec3& p, double bound2) const {
   const uint32_t id = ids_[slot];
-  if (id < triangleCount_) {
-    const Triangle& t = triangles_[slot];
-    const Vec3& n = normals_[slot];
-    const double plane = dot(n, p - t.v[0]);
-    if (plane * plane > bound2 * dot(n, n) * (1 + 1e-12)) return INFINITY;
-    return squaredDistanceToTriangle(t.v[0], t.v[1], t.v[2], p);
-  }
+  if (id < triangleCount_) return squaredDistanceToTriangleWithin(triangles_[slot], normals_[slot], p, bound2);
   const Vec3 d = p - closestPointOnEllipsoid(shapes_[id - triangleCount_], p);
   return dot(d, d);
 }

@@ -45,9 +45,7 @@ void denseSignedDistances(const Grid& grid, const Scene& scene, std::span<double
                           const std::array<uint64_t, 3>& strides, const DistanceQueryOptions& options) {
   const NearestPrimitive nearest(scene);
   const InsideTest insideTest(scene);
-  std::array<std::vector<double>, 3> centres;
-  for (int a = 0; a < 3; ++a)
-    for (uint32_t i = 0; i < grid.dims[a]; ++i) centres[a].push_back(cellCentreOnAxis(grid.bounds, grid.dims, a, i));
+  const std::array<std::vector<double>, 3> centres = cellCentresByAxis(grid);
   // Rows run along the axis of the smallest stride, so each row's writes are adjacent and each cell's search is
   // bounded by its neighbour's distance.
   const int along = strides[0] <= strides[1] && strides[0] <= strides[2] ? 0 : (strides[1] <= strides[2] ? 1 : 2);

@@ -37,17 +37,6 @@ struct Candidate {
   bool operator<(const Candidate& o) const { return key < o.key; }
 };
 
-// The cells' centres along each axis, computed once (cellCentreOnAxis for every index).
-struct Centres {
-  std::array<std::vector<double>, 3> axis;
-  explicit Centres(const Grid& grid) {
-    for (int a = 0; a < 3; ++a) {
-      axis[a].resize(grid.dims[a]);
-      for (uint32_t i = 0; i < grid.dims[a]; ++i) axis[a][i] = cellCentreOnAxis(grid.bounds, grid.dims, a, i);
-    }
-  }
-};
-
 double smallestCellEdge(const Grid& grid) {
   double h = INFINITY;
   for (int a = 0; a < 3; ++a) h = std::min(h, (grid.bounds.hi[a] - grid.bounds.lo[a]) / grid.dims[a]);
@@ -64,32 +53,22 @@ struct Reachable {
   bool empty() const { return cells[0][0] > cells[0][1] || cells[1][0] > cells[1][1] || cells[2][0] > cells[2][1]; }
 };
 
-// The squared distance from c to primitive p (triangles first, then the spheres' shapes), or -1 when the triangle's
-// plane alone is farther than sqrt(bound2): most cells of a triangle's box, and cells a nearer triangle already took.
+// The squared distance from c to primitive p (triangles first, then the spheres' shapes), or +infinity when the
+// triangle's plane alone is farther than sqrt(bound2): most cells of a triangle's box, and cells a nearer triangle
+// already took.
 struct PrimitiveDistance {
   const Scene& scene;
   const std::vector<EllipsoidShape>& shapes;
   const std::vector<Vec3>& normals;  // triangles' (b - a) x (c - a)
 
   double operator()(size_t p, const Vec3& c, double bound2) const {
-    if (p < scene.triangles.size()) {
-      const Triangle& t = scene.triangles[p];
-      const double plane = dot(normals[p], c - t.v[0]);
-      if (plane * plane > bound2 * dot(normals[p], normals[p])) return -1;
-      return squaredDistanceToTriangle(t.v[0], t.v[1], t.v[2], c);
-    }
-    const EllipsoidShape& s = shapes[p - scene.triangles.size()];
-    const Vec3 d = c - closestPointOnEllipsoid(s, c);
+    if (p < scene.triangles.size()) return squaredDistanceToTriangleWithin(scene.triangles[p], normals[p], c, bound2);
+    const Vec3 d = c - closestPointOnEllipsoid(shapes[p - scene.triangles.size()], c);
     return dot(d, d);
   }
   Box box(size_t p) const {
-    if (p < scene.triangles.size()) {
-      const Triangle& t = scene.triangles[p];
-      return {minVec(minVec(t.v[0], t.v[1]), t.v[2]), maxVec(maxVec(t.v[0], t.v[1]), t.v[2])};
-    }
-    const EllipsoidShape& s = shapes[p - scene.triangles.size()];
-    const double big = s.semi.x;  // semi-axes descending
-    return {s.center - Vec3{big, big, big}, s.center + Vec3{big, big, big}};
+    return p < scene.triangles.size() ? triangleBounds(scene.triangles[p])
+                                      : ellipsoidBounds(shapes[p - scene.triangles.size()]);
   }
 };
 
@@ -101,7 +80,7 @@ struct TilePrim {
 
 // The band's cells with their nearest squared distance, in no particular order.
 std::vector<Candidate> bandCandidates(const Grid& grid, const Scene& scene, double reach, const SdfOptions& options) {
-  const Centres centres(grid);
+  const std::array<std::vector<double>, 3> centres = cellCentresByAxis(grid);
   std::vector<EllipsoidShape> shapes;
   for (const Sphere& s : scene.spheres) shapes.push_back(ellipsoidShape(s));
   std::vector<Vec3> normals(scene.triangles.size());
@@ -171,9 +150,8 @@ std::vector<Candidate> bandCandidates(const Grid& grid, const Scene& scene, doub
           for (int64_t j = lo[1]; j <= hi[1]; ++j)
             for (int64_t i = lo[0]; i <= hi[0]; ++i) {
               double& slot = nearest[size_t(i - t0[0]) + kTile * (size_t(j - t0[1]) + kTile * size_t(k - t0[2]))];
-              const double d2 =
-                  distance(p, {centres.axis[0][i], centres.axis[1][j], centres.axis[2][k]}, std::min(slot, reach2));
-              if (d2 >= 0 && d2 < slot) slot = d2;
+              const double d2 = distance(p, {centres[0][i], centres[1][j], centres[2][k]}, std::min(slot, reach2));
+              if (d2 < slot) slot = d2;
             }
       }
       for (uint32_t k = 0; k < kTile; ++k)

@@ -85,6 +85,8 @@ inline double cellCentreOnAxis(const Box& bounds, const std::array<uint32_t, 3>&
 }
 // The centre of the cell with `key`.
 Vec3 cellCentre(const Grid& grid, uint64_t key);
+// cellCentreOnAxis for every index of every axis: [axis][i], computed once for loops over many cells.
+std::array<std::vector<double>, 3> cellCentresByAxis(const Grid& grid);
 
 // Index of the occupied cell with `key`, or -1. O(log occupied).
 int64_t findCell(const Grid& grid, uint64_t key);

@@ -18,11 +18,16 @@ Vec3 closestPointOnTriangle(const Vec3& a, const Vec3& b, const Vec3& c, const V
 // the coordinates are large against the distance).
 double squaredDistanceToTriangle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& p);
 
+// squaredDistanceToTriangle when it can be at most bound2; +infinity, without computing it, when the plane of the
+// triangle (normal = (b - a) x (c - a)) alone is farther (with a margin of 1e-12, so rounding never skips a triangle
+// that could be within the bound). The band and the nearest-primitive search prune with it.
+double squaredDistanceToTriangleWithin(const Triangle& t, const Vec3& normal, const Vec3& p, double bound2);
+
 // The point of segment [a, b] nearest to p.
 Vec3 closestPointOnSegment(const Vec3& a, const Vec3& b, const Vec3& p);
 
 // A sphere or an ellipsoid in its principal frame: surface points are center + sum_i axes[i] * semi[i] * u_i with
-// |u| = 1; axes orthonormal, semi > 0 ascending.
+// |u| = 1; axes orthonormal, semi > 0 descending (Eberly's e0 >= e1 >= e2).
 struct EllipsoidShape {
   Vec3 center;
   std::array<Vec3, 3> axes{Vec3{1, 0, 0}, Vec3{0, 1, 0}, Vec3{0, 0, 1}};
@@ -39,6 +44,9 @@ EllipsoidShape ellipsoidShape(const Sphere& sphere);
 // from a Point to an Ellipse, an Ellipsoid, or a Hyperellipsoid", 2013): the root of a monotone function found by
 // bisection to the last bit, so the result is accurate to a few ulps of the semi-axes (docs/distance.md).
 Vec3 closestPointOnEllipsoid(const EllipsoidShape& shape, const Vec3& p);
+
+// The axis-aligned box around the shape (a cube of its longest semi-axis about its centre).
+Box ellipsoidBounds(const EllipsoidShape& shape);
 
 // Whether p lies strictly inside the shape (sum (u_i / semi_i)^2 < 1 in the principal frame).
 bool insideEllipsoid(const EllipsoidShape& shape, const Vec3& p);

@@ -77,6 +77,74 @@ TEST(NearestPrimitive, EqualsBruteForceBitForBit) {
   EXPECT_EQ(NearestPrimitive(Scene{}).nearest({0, 0, 0}).primitive, -1);
 }
 
+// The pruning's lower bound (plane and edge half-planes, triangleLowerBound) never skips a triangle whose computed
+// distance is within the bound, at scales 1e-6 to 1e6, 1e6 from the origin, on needles and slivers, for points on
+// vertices, on edges, in the plane and one ulp off it; and it does prune, or the test would prove nothing.
+TEST(TriangleLowerBound, NeverSkipsATriangleWithinTheBoundAtAnyScale) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  size_t checked = 0, pruned = 0;
+  for (const double scale : {1e-6, 1.0, 1e6})
+    for (const double offset : {0.0, 1e6})
+      for (int n = 0; n < 400; ++n) {
+        const Vec3 origin{offset, -offset, 0.5 * offset};
+        Triangle t;
+        for (Vec3& v : t.v) v = origin + Vec3{u(rng), u(rng), u(rng)} * scale;
+        if (n % 4 == 1) t.v[2] = t.v[0] + (t.v[1] - t.v[0]) * 0.5 + Vec3{0, 0, 1e-9 * scale};  // a needle
+        if (n % 4 == 2) t.v[2] = t.v[0] + (t.v[1] - t.v[0]) * 0.3;  // degenerate: a segment
+        const TriangleLowerBound bound = triangleLowerBound(t);
+        const Vec3 normal = cross(t.v[1] - t.v[0], t.v[2] - t.v[0]);
+        std::vector<Vec3> points;
+        for (int k = 0; k < 6; ++k) points.push_back(origin + Vec3{u(rng), u(rng), u(rng)} * (3 * scale));
+        for (const Vec3& v : t.v) points.push_back(v);
+        points.push_back((t.v[0] + t.v[1]) * 0.5);
+        const Vec3 inPlane = (t.v[0] + t.v[1] + t.v[2]) / 3.0;
+        points.push_back(inPlane);
+        points.push_back(inPlane + normal * (1e-300 / std::max(length(normal), 1e-300)));
+        points.push_back({std::nextafter(inPlane.x, INFINITY), inPlane.y, inPlane.z});
+        for (const Vec3& p : points) {
+          const double d2 = squaredDistanceToTriangle(t.v[0], t.v[1], t.v[2], p);
+          ASSERT_EQ(squaredDistanceToTriangleWithin(t, bound, p, d2), d2) << scale << " " << offset << " " << n;
+          ++checked;
+          if (d2 > 0) pruned += squaredDistanceToTriangleWithin(t, bound, p, 0.25 * d2) == INFINITY;
+        }
+      }
+  EXPECT_GT(pruned, checked / 4) << "of " << checked;
+}
+
+// Searches seeded from any primitive, on a fan whose centre vertex six triangles share (ties to the lowest id), a
+// mesh 1e6 from the origin with 1e-3 triangles, and a scene of needles: equal to brute force bit for bit.
+TEST(NearestPrimitive, SeededSearchesEqualBruteForceOnFansFarScenesAndNeedles) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (const double offset : {0.0, 1e6}) {
+    Scene s;
+    const Vec3 o{offset, offset, -offset};
+    for (int k = 0; k < 6; ++k) {  // the fan: equidistant from points straight above its centre
+      const double a0 = k * M_PI / 3, a1 = (k + 1) * M_PI / 3, r = 1e-3;
+      s.triangles.push_back({{o, o + Vec3{r * std::cos(a0), r * std::sin(a0), 0},
+                              o + Vec3{r * std::cos(a1), r * std::sin(a1), 0}}});
+    }
+    for (int k = 0; k < 300; ++k) {  // needles and small triangles around it
+      const Vec3 a = o + Vec3{u(rng), u(rng), u(rng)} * 4e-3, b = a + Vec3{u(rng), u(rng), u(rng)} * 1e-3;
+      const Vec3 c = k % 2 ? a + (b - a) * 0.5 + Vec3{1e-12, 0, 0} : a + Vec3{u(rng), u(rng), u(rng)} * 1e-3;
+      s.triangles.push_back({{a, b, c}});
+    }
+    std::vector<EllipsoidShape> shapes;
+    const NearestPrimitive nearest(s);
+    for (int n = 0; n < 2000; ++n) {
+      Vec3 p = o + Vec3{u(rng), u(rng), u(rng)} * 6e-3;
+      if (n % 4 == 0) p = o + Vec3{0, 0, 1e-4 * (1 + n % 7)};  // above the fan's centre: six ties
+      if (n % 4 == 1) p = s.triangles[size_t(n) % s.triangles.size()].v[n % 3];
+      int64_t id;
+      const double want = dqBruteDistance2(s, shapes, p, &id);
+      const NearestHit hit = nearest.nearestFrom(p, int64_t(n * 7919) % int64_t(s.triangles.size()));
+      ASSERT_EQ(hit.squaredDistance, want) << offset << " " << n;
+      ASSERT_EQ(hit.primitive, id) << offset << " " << n;
+    }
+  }
+}
+
 Grid dqFilledGrid(const Scene& s, std::array<uint32_t, 3> dims) {
   VoxelizeOptions o;
   o.dims = dims;

@@ -176,6 +176,14 @@ std::array<double, 3> closestOnEllipsoid(const double e[3], const double y[3]) {
 
 }  // namespace
 
+std::array<Vec3, 3> symmetricEigenvectors(const std::array<std::array<double, 3>, 3>& m) {
+  double a[3][3], v[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) a[i][j] = m[i][j];
+  jacobiEigen(a, v);
+  return {Vec3{v[0][0], v[1][0], v[2][0]}, Vec3{v[0][1], v[1][1], v[2][1]}, Vec3{v[0][2], v[1][2], v[2][2]}};
+}
+
 EllipsoidShape ellipsoidShape(const Sphere& sphere) {
   EllipsoidShape shape;
   if (!sphere.isEllipsoid()) {
@@ -229,9 +237,37 @@ bool insideEllipsoid(const EllipsoidShape& shape, const Vec3& p) {
   return sum < 1;
 }
 
-double squaredDistanceToTriangleWithin(const Triangle& t, const Vec3& normal, const Vec3& p, double bound2) {
-  const double plane = dot(normal, p - t.v[0]);
-  if (plane * plane > bound2 * dot(normal, normal) * (1 + 1e-12)) return INFINITY;
+TriangleLowerBound triangleLowerBound(const Triangle& t) {
+  TriangleLowerBound b;
+  const Vec3 ab = t.v[1] - t.v[0], ac = t.v[2] - t.v[0], bc = t.v[2] - t.v[1];
+  const Vec3 n = cross(ab, ac);
+  const double area2 = length(n), product = length(ab) * length(ac);
+  // The normal's direction errs by a few ulps times this conditioning (the cross product of two near-parallel
+  // edges cancels); every later rounding is a few ulps of |p - corner|. 1e-13 per unit covers both with a wide
+  // margin, and a conditioning past 1e6 (a needle) is not used at all.
+  const double conditioning = product / area2;
+  if (!(area2 > 0) || !(conditioning < 1e6)) return b;
+  b.normal = n / area2;
+  const Vec3 edges[3] = {ab, bc, t.v[0] - t.v[2]};
+  for (int e = 0; e < 3; ++e) b.edgeNormals[e] = normalize(cross(edges[e], b.normal));
+  const auto l1 = [](const Vec3& v) { return std::fabs(v.x) + std::fabs(v.y) + std::fabs(v.z); };
+  b.slack = 1e-13 * conditioning;
+  b.slackAt0 = b.slack * std::max({l1(ab), l1(ac), l1(bc)});
+  b.usable = true;
+  return b;
+}
+
+double squaredDistanceToTriangleWithin(const Triangle& t, const TriangleLowerBound& bound, const Vec3& p,
+                                       double bound2) {
+  if (bound.usable) {
+    const Vec3 pa = p - t.v[0];
+    const double err = bound.slack * (std::fabs(pa.x) + std::fabs(pa.y) + std::fabs(pa.z)) + bound.slackAt0;
+    const double h = std::max(0.0, std::fabs(dot(bound.normal, pa)) - err);
+    const double outside = std::max({dot(bound.edgeNormals[0], pa), dot(bound.edgeNormals[1], p - t.v[1]),
+                                     dot(bound.edgeNormals[2], p - t.v[2])});
+    const double s = std::max(0.0, outside - err);
+    if (h * h + s * s > bound2) return INFINITY;
+  }
   return squaredDistanceToTriangle(t.v[0], t.v[1], t.v[2], p);
 }
 

@@ -12,16 +12,32 @@ namespace {
 
 constexpr uint32_t kLeafSize = 4;
 
-double squaredDistanceToBox(const Box& b, const Vec3& p) {
+Box unite(const Box& a, const Box& b) { return {minVec(a.lo, b.lo), maxVec(a.hi, b.hi)}; }
+
+// A lower bound of the squared distance from p to anything inside the box: the box's own distance, less a rounding
+// allowance (the axes are orthonormal only to rounding, and the projections round relative to |p - centre|).
+double squaredDistanceToOrientedBox(const NearestPrimitive::OrientedBox& b, const Vec3& p) {
+  const Vec3 d = p - b.centre;
+  const double err = 1e-13 * (std::fabs(d.x) + std::fabs(d.y) + std::fabs(d.z));
   double sum = 0;
   for (int a = 0; a < 3; ++a) {
-    const double d = std::max({b.lo[a] - p[a], 0.0, p[a] - b.hi[a]});
-    sum += d * d;
+    const double outside = std::fabs(dot(b.axes[a], d)) - b.half[a] - err;
+    const double e = outside > 0 ? outside : 0.0;  // a maxsd, where std::max's NaN rules make a branch
+    sum += e * e;
   }
-  return sum;
+  return sum * (1 - 1e-12);
 }
 
-Box unite(const Box& a, const Box& b) { return {minVec(a.lo, b.lo), maxVec(a.hi, b.hi)}; }
+// The points whose convex hull holds primitive `id`: a triangle's corners, the corners of a sphere's box.
+template <typename Visit>
+void forHullPoints(const Scene& scene, const std::vector<Box>& boxes, uint32_t id, const Visit& visit) {
+  if (id < scene.triangles.size()) {
+    for (const Vec3& v : scene.triangles[id].v) visit(v);
+    return;
+  }
+  const Box& b = boxes[id];
+  for (int c = 0; c < 8; ++c) visit(Vec3{c & 1 ? b.hi.x : b.lo.x, c & 2 ? b.hi.y : b.lo.y, c & 4 ? b.hi.z : b.lo.z});
+}
 
 }  // namespace
 
@@ -38,31 +54,67 @@ NearestPrimitive::NearestPrimitive(const Scene& scene) : triangleCount_(uint32_t
   std::iota(ids_.begin(), ids_.end(), 0u);
   if (n > 0) {
     nodes_.reserve(2 * (n / kLeafSize + 1));
-    build(0, uint32_t(n), centroids, boxes);
+    build(0, uint32_t(n), centroids, boxes, scene);
   }
   // Triangles copied in leaf order, so a leaf's are adjacent in memory.
   triangles_.resize(n);
-  normals_.resize(n);
+  bounds_.resize(n);
   slotOf_.resize(n);
   for (size_t s = 0; s < n; ++s) slotOf_[ids_[s]] = uint32_t(s);
   for (size_t s = 0; s < n; ++s)
     if (ids_[s] < triangleCount_) {
       const Triangle& t = scene.triangles[ids_[s]];
       triangles_[s] = t;
-      normals_[s] = cross(t.v[1] - t.v[0], t.v[2] - t.v[0]);
+      bounds_[s] = triangleLowerBound(t);
     }
 }
 
-// Median split of the centroids on the box's longest axis: balanced, and built in O(n log n).
-uint32_t NearestPrimitive::build(uint32_t begin, uint32_t end, std::vector<Vec3>& centroids, std::vector<Box>& boxes) {
+// The oriented box of the primitives in slots [begin, end): the principal axes of their hull points (a tight slab
+// around a flat patch, where an axis-aligned box leaves a wide margin), its extents taken about the final centre and
+// widened for the projections' rounding, so that every point of every primitive lies inside.
+NearestPrimitive::OrientedBox NearestPrimitive::orientedBounds(uint32_t begin, uint32_t end, const Scene& scene,
+                                                                const std::vector<Box>& boxes) const {
+  Vec3 sum{0, 0, 0};
+  double count = 0;
+  for (uint32_t s = begin; s < end; ++s) forHullPoints(scene, boxes, ids_[s], [&](const Vec3& q) { sum = sum + q, ++count; });
+  const Vec3 mean = sum / count;
+  std::array<std::array<double, 3>, 3> covariance{};
+  for (uint32_t s = begin; s < end; ++s)
+    forHullPoints(scene, boxes, ids_[s], [&](const Vec3& q) {
+      const Vec3 d = q - mean;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) covariance[i][j] += d[i] * d[j];
+    });
+  OrientedBox box;
+  box.axes = symmetricEigenvectors(covariance);
+  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi = lo * -1.0;
+  for (uint32_t s = begin; s < end; ++s)
+    forHullPoints(scene, boxes, ids_[s], [&](const Vec3& q) {
+      for (int a = 0; a < 3; ++a) {
+        const double u = dot(box.axes[a], q - mean);
+        lo.at(a) = std::min(lo[a], u), hi.at(a) = std::max(hi[a], u);
+      }
+    });
+  box.centre = mean;
+  for (int a = 0; a < 3; ++a) box.centre = box.centre + box.axes[a] * (0.5 * (lo[a] + hi[a]));
+  box.half = {0, 0, 0};
+  for (uint32_t s = begin; s < end; ++s)
+    forHullPoints(scene, boxes, ids_[s], [&](const Vec3& q) {
+      for (int a = 0; a < 3; ++a) box.half.at(a) = std::max(box.half[a], std::fabs(dot(box.axes[a], q - box.centre)));
+    });
+  const double widen = 1e-12 * (box.half.x + box.half.y + box.half.z);
+  for (int a = 0; a < 3; ++a) box.half.at(a) = box.half[a] * (1 + 1e-12) + widen;
+  return box;
+}
+
+// Median split of the centroids on the longest axis of their spread: balanced, and built in O(n log n).
+uint32_t NearestPrimitive::build(uint32_t begin, uint32_t end, std::vector<Vec3>& centroids, std::vector<Box>& boxes,
+                                 const Scene& scene) {
   const uint32_t index = uint32_t(nodes_.size());
   nodes_.push_back({});
-  Box box = boxes[ids_[begin]], spread{centroids[ids_[begin]], centroids[ids_[begin]]};
-  for (uint32_t s = begin + 1; s < end; ++s) {
-    box = unite(box, boxes[ids_[s]]);
-    spread = unite(spread, {centroids[ids_[s]], centroids[ids_[s]]});
-  }
-  nodes_[index].box = box;
+  Box spread{centroids[ids_[begin]], centroids[ids_[begin]]};
+  for (uint32_t s = begin + 1; s < end; ++s) spread = unite(spread, {centroids[ids_[s]], centroids[ids_[s]]});
+  nodes_[index].box = orientedBounds(begin, end, scene, boxes);
   if (end - begin <= kLeafSize) {
     nodes_[index].first = begin;
     nodes_[index].count = end - begin;
@@ -74,8 +126,8 @@ uint32_t NearestPrimitive::build(uint32_t begin, uint32_t end, std::vector<Vec3>
   std::nth_element(ids_.begin() + begin, ids_.begin() + mid, ids_.begin() + end, [&](uint32_t a, uint32_t b) {
     return centroids[a][axis] != centroids[b][axis] ? centroids[a][axis] < centroids[b][axis] : a < b;
   });
-  build(begin, mid, centroids, boxes);
-  nodes_[index].first = build(mid, end, centroids, boxes);
+  build(begin, mid, centroids, boxes, scene);
+  nodes_[index].first = build(mid, end, centroids, boxes, scene);
   return index;
 }
 
@@ -83,23 +135,52 @@ uint32_t NearestPrimitive::build(uint32_t begin, uint32_t end, std::vector<Vec3>
 // than bound2 (squaredDistanceToTriangleWithin).
 double NearestPrimitive::squaredDistanceTo(uint32_t slot, const Vec3& p, double bound2) const {
   const uint32_t id = ids_[slot];
-  if (id < triangleCount_) return squaredDistanceToTriangleWithin(triangles_[slot], normals_[slot], p, bound2);
+  if (id < triangleCount_) return squaredDistanceToTriangleWithin(triangles_[slot], bounds_[slot], p, bound2);
   const Vec3 d = p - closestPointOnEllipsoid(shapes_[id - triangleCount_], p);
   return dot(d, d);
+}
+
+NearestHit NearestPrimitive::nearestFrom(const Vec3& p, int64_t seed) const {
+  if (seed < 0 || uint64_t(seed) >= ids_.size()) return nearest(p);
+  NearestHit best{squaredDistanceTo(slotOf_[size_t(seed)], p, INFINITY), seed};
+  search(p, best);
+  return best;
 }
 
 NearestHit NearestPrimitive::nearest(const Vec3& p, double bound2) const {
   NearestHit best;
   best.squaredDistance = bound2;
-  if (nodes_.empty()) return {};
-  // Depth is about log2(n / kLeafSize) + 1 for a median split: 64 holds any 32-bit count.
-  std::array<uint32_t, 64> stack;
+  search(p, best);
+  if (best.primitive < 0) best.squaredDistance = INFINITY;
+  return best;
+}
+
+// Lowers `best` to the nearest primitive within it (ties to the lowest id): every subtree whose box is no farther
+// than the best so far is visited, nearer child first.
+void NearestPrimitive::search(const Vec3& p, NearestHit& best) const {
+  if (nodes_.empty()) return;
+  // Depth is about log2(n / kLeafSize) + 1 for a median split: 64 holds any 32-bit count. Each waiting subtree
+  // keeps its box's squared distance, so that it is tested again without recomputing it.
+  struct Waiting {
+    uint32_t node;
+    double d2;
+  };
+  std::array<Waiting, 64> stack;
   size_t top = 0;
-  stack[top++] = 0;
-  while (top > 0) {
-    const Node& node = nodes_[stack[--top]];
-    if (squaredDistanceToBox(node.box, p) > best.squaredDistance) continue;
-    if (node.count > 0) {
+  uint32_t current = 0;
+  double currentD2 = squaredDistanceToOrientedBox(nodes_[0].box, p);
+  for (;;) {
+    if (currentD2 <= best.squaredDistance) {
+      const Node& node = nodes_[current];
+      if (node.count == 0) {
+        const uint32_t a = current + 1, b = node.first;
+        const double da = squaredDistanceToOrientedBox(nodes_[a].box, p), db = squaredDistanceToOrientedBox(nodes_[b].box, p);
+        const bool aFirst = da <= db;
+        stack[top++] = {aFirst ? b : a, aFirst ? db : da};  // the farther child waits
+        current = aFirst ? a : b;
+        currentD2 = aFirst ? da : db;
+        continue;
+      }
       for (uint32_t s = node.first; s < node.first + node.count; ++s) {
         const double d2 = squaredDistanceTo(s, p, best.squaredDistance);
         const int64_t id = ids_[s];
@@ -108,15 +189,12 @@ NearestHit NearestPrimitive::nearest(const Vec3& p, double bound2) const {
           best.primitive = id;
         }
       }
-      continue;
     }
-    const uint32_t a = uint32_t(&node - nodes_.data()) + 1, b = node.first;
-    const double da = squaredDistanceToBox(nodes_[a].box, p), db = squaredDistanceToBox(nodes_[b].box, p);
-    stack[top++] = da <= db ? b : a;  // the farther child waits
-    stack[top++] = da <= db ? a : b;
+    if (top == 0) return;
+    --top;
+    current = stack[top].node;
+    currentD2 = stack[top].d2;
   }
-  if (best.primitive < 0) best.squaredDistance = INFINITY;
-  return best;
 }
 
 Vec3 NearestPrimitive::closestPoint(int64_t id, const Vec3& p) const {

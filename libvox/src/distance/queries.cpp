@@ -32,12 +32,6 @@ struct QueryProgress {
   }
 };
 
-// An upper bound of d(p)^2 from a neighbour q at distance d(q), |p - q| <= step: (d(q) + step)^2, rounded up by a
-// relative 1e-12 so that rounding never makes it smaller than the true value.
-double neighbourBound2(double d, double step) {
-  const double b = (d + step) * (1 + 1e-12);
-  return b * b;
-}
 
 }  // namespace
 
@@ -58,15 +52,13 @@ void denseSignedDistances(const Grid& grid, const Scene& scene, std::span<double
       uint32_t ijk[3];
       ijk[u] = uint32_t(row % grid.dims[u]);
       ijk[v] = uint32_t(row / grid.dims[u]);
-      double previous = INFINITY;
+      int64_t previous = -1;  // the nearest primitive of the row's cell before: the next cell's search starts from it
       for (uint32_t s = 0; s < length; ++s) {
         ijk[along] = s;
         const Vec3 c{centres[0][ijk[0]], centres[1][ijk[1]], centres[2][ijk[2]]};
-        const double step = s > 0 ? centres[along][s] - centres[along][s - 1] : INFINITY;
-        NearestHit hit = nearest.nearest(c, s > 0 ? neighbourBound2(previous, step) : INFINITY);
-        if (hit.primitive < 0 && s > 0) hit = nearest.nearest(c);  // the bound was too tight after all
+        const NearestHit hit = nearest.nearestFrom(c, previous);
+        previous = hit.primitive;
         const double d = std::sqrt(hit.squaredDistance);
-        previous = d;
         const uint64_t key = cellKey(grid.dims, ijk[0], ijk[1], ijk[2]);
         const bool inside = findCell(grid, key) >= 0 ? d > 0 && insideTest.inside(c) : isSolid(grid, key);
         out[ijk[0] * strides[0] + ijk[1] * strides[1] + ijk[2] * strides[2]] = inside ? -d : d;
@@ -129,17 +121,13 @@ void pointDistances(const Scene& scene, std::span<const double> points, bool sig
   QueryProgress progress{options, n};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
     if (progress.cancelled) return;
-    Vec3 previous;
-    double previousDistance = INFINITY;
+    int64_t previous = -1;  // the nearest primitive of the point before in spatial order: this one's search starts there
     for (size_t k = r.begin(); k < r.end(); ++k) {
       const size_t i = order[k];
       const Vec3 p{points[3 * i], points[3 * i + 1], points[3 * i + 2]};
-      const double bound2 = k > r.begin() ? neighbourBound2(previousDistance, length(p - previous)) : INFINITY;
-      NearestHit hit = nearest.nearest(p, bound2);
-      if (hit.primitive < 0 && bound2 < INFINITY) hit = nearest.nearest(p);  // the bound was too tight after all
+      const NearestHit hit = nearest.nearestFrom(p, previous);
+      previous = hit.primitive;
       const double d = std::sqrt(hit.squaredDistance);
-      previous = p;
-      previousDistance = d;
       const Vec3 c = nearest.closestPoint(hit.primitive, p);
       out.distance[i] = insideTest && d > 0 && insideTest->inside(p) ? -d : d;
       out.primitive[i] = hit.primitive;

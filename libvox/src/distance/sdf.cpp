@@ -59,10 +59,10 @@ struct Reachable {
 struct PrimitiveDistance {
   const Scene& scene;
   const std::vector<EllipsoidShape>& shapes;
-  const std::vector<Vec3>& normals;  // triangles' (b - a) x (c - a)
+  const std::vector<TriangleLowerBound>& bounds;  // of the triangles
 
   double operator()(size_t p, const Vec3& c, double bound2) const {
-    if (p < scene.triangles.size()) return squaredDistanceToTriangleWithin(scene.triangles[p], normals[p], c, bound2);
+    if (p < scene.triangles.size()) return squaredDistanceToTriangleWithin(scene.triangles[p], bounds[p], c, bound2);
     const Vec3 d = c - closestPointOnEllipsoid(shapes[p - scene.triangles.size()], c);
     return dot(d, d);
   }
@@ -83,12 +83,9 @@ std::vector<Candidate> bandCandidates(const Grid& grid, const Scene& scene, doub
   const std::array<std::vector<double>, 3> centres = cellCentresByAxis(grid);
   std::vector<EllipsoidShape> shapes;
   for (const Sphere& s : scene.spheres) shapes.push_back(ellipsoidShape(s));
-  std::vector<Vec3> normals(scene.triangles.size());
-  for (size_t t = 0; t < normals.size(); ++t) {
-    const Triangle& tr = scene.triangles[t];
-    normals[t] = cross(tr.v[1] - tr.v[0], tr.v[2] - tr.v[0]);
-  }
-  const PrimitiveDistance distance{scene, shapes, normals};
+  std::vector<TriangleLowerBound> bounds(scene.triangles.size());
+  for (size_t t = 0; t < bounds.size(); ++t) bounds[t] = triangleLowerBound(scene.triangles[t]);
+  const PrimitiveDistance distance{scene, shapes, bounds};
   const size_t prims = scene.triangles.size() + shapes.size();
   std::array<uint64_t, 3> tiles;
   for (int a = 0; a < 3; ++a) tiles[a] = (grid.dims[a] + kTile - 1) / kTile;

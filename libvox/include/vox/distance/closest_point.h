@@ -18,10 +18,24 @@ Vec3 closestPointOnTriangle(const Vec3& a, const Vec3& b, const Vec3& c, const V
 // the coordinates are large against the distance).
 double squaredDistanceToTriangle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& p);
 
-// squaredDistanceToTriangle when it can be at most bound2; +infinity, without computing it, when the plane of the
-// triangle (normal = (b - a) x (c - a)) alone is farther (with a margin of 1e-12, so rounding never skips a triangle
-// that could be within the bound). The band and the nearest-primitive search prune with it.
-double squaredDistanceToTriangleWithin(const Triangle& t, const Vec3& normal, const Vec3& p, double bound2);
+// What a lower bound of the distance from any point to one triangle needs, computed once per triangle: the unit
+// normal, and the unit normals of the three edges in the triangle's plane, pointing out (edge a->b, b->c, c->a).
+// The distance from p is at least that to the plane joined with the edge it lies farthest outside of (the triangle
+// lies in the half-plane inside each edge); that bound is the distance itself except in a vertex's region.
+struct TriangleLowerBound {
+  Vec3 normal;
+  std::array<Vec3, 3> edgeNormals;
+  double slack = 0;     // the bound's rounding, per unit of |p - a|_1: a multiple of the normal's conditioning
+  double slackAt0 = 0;  // ... and its part from the triangle's own size
+  bool usable = false;  // false for a degenerate or needle triangle, whose normal rounding cannot bound: no pruning
+};
+TriangleLowerBound triangleLowerBound(const Triangle& t);
+
+// squaredDistanceToTriangle when it can be at most bound2; +infinity, without computing it, when the lower bound
+// above, made smaller by its rounding error and by the distance's own, is farther: so rounding never skips a
+// triangle whose computed distance is within the bound. The band and the nearest-primitive search prune with it.
+double squaredDistanceToTriangleWithin(const Triangle& t, const TriangleLowerBound& bound, const Vec3& p,
+                                       double bound2);
 
 // The point of segment [a, b] nearest to p.
 Vec3 closestPointOnSegment(const Vec3& a, const Vec3& b, const Vec3& p);
@@ -34,6 +48,9 @@ struct EllipsoidShape {
   Vec3 semi{1, 1, 1};
   bool isSphere = true;  // all semi-axes equal: the closed form applies
 };
+
+// The eigenvectors of the symmetric matrix m (cyclic Jacobi rotations to convergence): orthonormal to rounding.
+std::array<Vec3, 3> symmetricEigenvectors(const std::array<std::array<double, 3>, 3>& m);
 
 // The principal frame of a scene sphere: the sphere itself, or the ellipsoid its transform makes (the eigenvectors
 // of L L^T, L the transform's linear part, by cyclic Jacobi rotations to convergence). Throws InputError for a

@@ -28,26 +28,38 @@ class NearestPrimitive {
   // not exceed (a neighbour's distance plus their separation, rounded up), which prunes the search; subtrees and
   // primitives farther than it are skipped, so a bound below the true distance gives primitive -1.
   NearestHit nearest(const Vec3& p, double bound2 = INFINITY) const;
+  // The same answer, searched from primitive `seed` (a neighbour's nearest, or -1 for none): its distance is the
+  // first bound, which is tight when the seed is the answer or nearly so, so the search visits few nodes.
+  NearestHit nearestFrom(const Vec3& p, int64_t seed) const;
 
   // The point of primitive `id` nearest to p.
   Vec3 closestPoint(int64_t id, const Vec3& p) const;
 
   size_t primitiveCount() const { return ids_.size(); }
 
+  struct OrientedBox {
+    Vec3 centre;
+    std::array<Vec3, 3> axes;  // orthonormal to rounding
+    Vec3 half;                 // half extents along the axes
+  };
+
  private:
   struct Node {
-    Box box;
+    OrientedBox box;
     uint32_t first = 0;  // leaf: its first primitive slot; inner: the second child (the first is the next node)
     uint32_t count = 0;  // primitives of a leaf; 0 for an inner node
   };
   double squaredDistanceTo(uint32_t slot, const Vec3& p, double bound2) const;
-  uint32_t build(uint32_t begin, uint32_t end, std::vector<Vec3>& centroids, std::vector<Box>& boxes);
+  void search(const Vec3& p, NearestHit& best) const;
+  uint32_t build(uint32_t begin, uint32_t end, std::vector<Vec3>& centroids, std::vector<Box>& boxes,
+                 const Scene& scene);
+  OrientedBox orientedBounds(uint32_t begin, uint32_t end, const Scene& scene, const std::vector<Box>& boxes) const;
 
   std::vector<Node> nodes_;
   std::vector<uint32_t> ids_;           // slot -> primitive id, in leaf order
   std::vector<uint32_t> slotOf_;        // primitive id -> slot
   std::vector<Triangle> triangles_;     // by slot (unused slots of spheres hold nothing useful)
-  std::vector<Vec3> normals_;           // by slot: (b - a) x (c - a) of triangles
+  std::vector<TriangleLowerBound> bounds_;  // by slot, of triangles
   std::vector<EllipsoidShape> shapes_;  // by sphere index
   uint32_t triangleCount_ = 0;
 };

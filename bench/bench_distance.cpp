@@ -92,8 +92,8 @@ int main(int argc, char** argv) {
     std::vector<double> field(grid.cellCount());
     const std::array<uint64_t, 3> strides{uint64_t(grid.dims[1]) * grid.dims[2], grid.dims[2], 1};
     const double dense = best(runs, [&] { vox::denseSignedDistances(grid, scene, field, strides); });
-    std::printf("sdf %u (%u x %u x %u): voxelize %.3f s, fill %.3f s, dense %.3f s, total %.3f s, %.0f cells/s\n",
-                res, grid.dims[0], grid.dims[1], grid.dims[2], voxelize, fill, dense, voxelize + fill + dense,
+    std::printf("sdf %u (%u x %u x %u): voxelize %.3f s, fill %.3f s, dense %.3f s, total %.3f s, %.0f cells/s\n", res,
+                grid.dims[0], grid.dims[1], grid.dims[2], voxelize, fill, dense, voxelize + fill + dense,
                 double(field.size()) / (voxelize + fill + dense));
   }
   return 0;

@@ -91,7 +91,7 @@ TEST(TriangleLowerBound, NeverSkipsATriangleWithinTheBoundAtAnyScale) {
         Triangle t;
         for (Vec3& v : t.v) v = origin + Vec3{u(rng), u(rng), u(rng)} * scale;
         if (n % 4 == 1) t.v[2] = t.v[0] + (t.v[1] - t.v[0]) * 0.5 + Vec3{0, 0, 1e-9 * scale};  // a needle
-        if (n % 4 == 2) t.v[2] = t.v[0] + (t.v[1] - t.v[0]) * 0.3;  // degenerate: a segment
+        if (n % 4 == 2) t.v[2] = t.v[0] + (t.v[1] - t.v[0]) * 0.3;                             // degenerate: a segment
         const TriangleLowerBound bound = triangleLowerBound(t);
         const Vec3 normal = cross(t.v[1] - t.v[0], t.v[2] - t.v[0]);
         std::vector<Vec3> points;
@@ -122,8 +122,8 @@ TEST(NearestPrimitive, SeededSearchesEqualBruteForceOnFansFarScenesAndNeedles) {
     const Vec3 o{offset, offset, -offset};
     for (int k = 0; k < 6; ++k) {  // the fan: equidistant from points straight above its centre
       const double a0 = k * M_PI / 3, a1 = (k + 1) * M_PI / 3, r = 1e-3;
-      s.triangles.push_back({{o, o + Vec3{r * std::cos(a0), r * std::sin(a0), 0},
-                              o + Vec3{r * std::cos(a1), r * std::sin(a1), 0}}});
+      s.triangles.push_back(
+          {{o, o + Vec3{r * std::cos(a0), r * std::sin(a0), 0}, o + Vec3{r * std::cos(a1), r * std::sin(a1), 0}}});
     }
     for (int k = 0; k < 300; ++k) {  // needles and small triangles around it
       const Vec3 a = o + Vec3{u(rng), u(rng), u(rng)} * 4e-3, b = a + Vec3{u(rng), u(rng), u(rng)} * 1e-3;

@@ -263,8 +263,8 @@ double squaredDistanceToTriangleWithin(const Triangle& t, const TriangleLowerBou
     const Vec3 pa = p - t.v[0];
     const double err = bound.slack * (std::fabs(pa.x) + std::fabs(pa.y) + std::fabs(pa.z)) + bound.slackAt0;
     const double h = std::max(0.0, std::fabs(dot(bound.normal, pa)) - err);
-    const double outside = std::max({dot(bound.edgeNormals[0], pa), dot(bound.edgeNormals[1], p - t.v[1]),
-                                     dot(bound.edgeNormals[2], p - t.v[2])});
+    const double outside = std::max(
+        {dot(bound.edgeNormals[0], pa), dot(bound.edgeNormals[1], p - t.v[1]), dot(bound.edgeNormals[2], p - t.v[2])});
     const double s = std::max(0.0, outside - err);
     if (h * h + s * s > bound2) return INFINITY;
   }

@@ -73,10 +73,11 @@ NearestPrimitive::NearestPrimitive(const Scene& scene) : triangleCount_(uint32_t
 // around a flat patch, where an axis-aligned box leaves a wide margin), its extents taken about the final centre and
 // widened for the projections' rounding, so that every point of every primitive lies inside.
 NearestPrimitive::OrientedBox NearestPrimitive::orientedBounds(uint32_t begin, uint32_t end, const Scene& scene,
-                                                                const std::vector<Box>& boxes) const {
+                                                               const std::vector<Box>& boxes) const {
   Vec3 sum{0, 0, 0};
   double count = 0;
-  for (uint32_t s = begin; s < end; ++s) forHullPoints(scene, boxes, ids_[s], [&](const Vec3& q) { sum = sum + q, ++count; });
+  for (uint32_t s = begin; s < end; ++s)
+    forHullPoints(scene, boxes, ids_[s], [&](const Vec3& q) { sum = sum + q, ++count; });
   const Vec3 mean = sum / count;
   std::array<std::array<double, 3>, 3> covariance{};
   for (uint32_t s = begin; s < end; ++s)
@@ -174,7 +175,8 @@ void NearestPrimitive::search(const Vec3& p, NearestHit& best) const {
       const Node& node = nodes_[current];
       if (node.count == 0) {
         const uint32_t a = current + 1, b = node.first;
-        const double da = squaredDistanceToOrientedBox(nodes_[a].box, p), db = squaredDistanceToOrientedBox(nodes_[b].box, p);
+        const double da = squaredDistanceToOrientedBox(nodes_[a].box, p),
+                     db = squaredDistanceToOrientedBox(nodes_[b].box, p);
         const bool aFirst = da <= db;
         stack[top++] = {aFirst ? b : a, aFirst ? db : da};  // the farther child waits
         current = aFirst ? a : b;

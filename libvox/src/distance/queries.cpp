@@ -32,7 +32,6 @@ struct QueryProgress {
   }
 };
 
-
 }  // namespace
 
 void denseSignedDistances(const Grid& grid, const Scene& scene, std::span<double> out,
@@ -121,7 +120,8 @@ void pointDistances(const Scene& scene, std::span<const double> points, bool sig
   QueryProgress progress{options, n};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
     if (progress.cancelled) return;
-    int64_t previous = -1;  // the nearest primitive of the point before in spatial order: this one's search starts there
+    int64_t previous =
+        -1;  // the nearest primitive of the point before in spatial order: this one's search starts there
     for (size_t k = r.begin(); k < r.end(); ++k) {
       const size_t i = order[k];
       const Vec3 p{points[3 * i], points[3 * i + 1], points[3 * i + 2]};

@@ -56,11 +56,11 @@ class NearestPrimitive {
   OrientedBox orientedBounds(uint32_t begin, uint32_t end, const Scene& scene, const std::vector<Box>& boxes) const;
 
   std::vector<Node> nodes_;
-  std::vector<uint32_t> ids_;           // slot -> primitive id, in leaf order
-  std::vector<uint32_t> slotOf_;        // primitive id -> slot
-  std::vector<Triangle> triangles_;     // by slot (unused slots of spheres hold nothing useful)
+  std::vector<uint32_t> ids_;               // slot -> primitive id, in leaf order
+  std::vector<uint32_t> slotOf_;            // primitive id -> slot
+  std::vector<Triangle> triangles_;         // by slot (unused slots of spheres hold nothing useful)
   std::vector<TriangleLowerBound> bounds_;  // by slot, of triangles
-  std::vector<EllipsoidShape> shapes_;  // by sphere index
+  std::vector<EllipsoidShape> shapes_;      // by sphere index
   uint32_t triangleCount_ = 0;
 };
 

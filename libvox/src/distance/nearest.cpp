@@ -6,6 +6,8 @@
 #include <limits>
 #include <numeric>
 
+#include <tbb/parallel_for.h>
+
 namespace vox {
 
 namespace {
@@ -54,12 +56,19 @@ NearestPrimitive::NearestPrimitive(const Scene& scene) : triangleCount_(uint32_t
   std::iota(ids_.begin(), ids_.end(), 0u);
   if (n > 0) {
     nodes_.reserve(2 * (n / kLeafSize + 1));
-    build(0, uint32_t(n), centroids, boxes, scene);
+    std::vector<std::array<uint32_t, 2>> ranges;  // each node's slots
+    build(0, uint32_t(n), centroids, ranges, 0);
+    // Each box depends only on its node's slots: all of them at once.
+    tbb::parallel_for(size_t(0), nodes_.size(),
+                      [&](size_t i) { nodes_[i].box = orientedBounds(ranges[i][0], ranges[i][1], scene, boxes); });
   }
   // Triangles copied in leaf order, so a leaf's are adjacent in memory.
   triangles_.resize(n);
   bounds_.resize(n);
   slotOf_.resize(n);
+  leafOf_.resize(n);
+  for (uint32_t i = 0; i < nodes_.size(); ++i)
+    for (uint32_t s = nodes_[i].first; s < nodes_[i].first + nodes_[i].count; ++s) leafOf_[s] = i;
   for (size_t s = 0; s < n; ++s) slotOf_[ids_[s]] = uint32_t(s);
   for (size_t s = 0; s < n; ++s)
     if (ids_[s] < triangleCount_) {
@@ -109,13 +118,14 @@ NearestPrimitive::OrientedBox NearestPrimitive::orientedBounds(uint32_t begin, u
 }
 
 // Median split of the centroids on the longest axis of their spread: balanced, and built in O(n log n).
-uint32_t NearestPrimitive::build(uint32_t begin, uint32_t end, std::vector<Vec3>& centroids, std::vector<Box>& boxes,
-                                 const Scene& scene) {
+uint32_t NearestPrimitive::build(uint32_t begin, uint32_t end, const std::vector<Vec3>& centroids,
+                                 std::vector<std::array<uint32_t, 2>>& ranges, uint32_t parent) {
   const uint32_t index = uint32_t(nodes_.size());
   nodes_.push_back({});
+  ranges.push_back({begin, end});
+  nodes_[index].parent = parent;
   Box spread{centroids[ids_[begin]], centroids[ids_[begin]]};
   for (uint32_t s = begin + 1; s < end; ++s) spread = unite(spread, {centroids[ids_[s]], centroids[ids_[s]]});
-  nodes_[index].box = orientedBounds(begin, end, scene, boxes);
   if (end - begin <= kLeafSize) {
     nodes_[index].first = begin;
     nodes_[index].count = end - begin;
@@ -127,8 +137,8 @@ uint32_t NearestPrimitive::build(uint32_t begin, uint32_t end, std::vector<Vec3>
   std::nth_element(ids_.begin() + begin, ids_.begin() + mid, ids_.begin() + end, [&](uint32_t a, uint32_t b) {
     return centroids[a][axis] != centroids[b][axis] ? centroids[a][axis] < centroids[b][axis] : a < b;
   });
-  build(begin, mid, centroids, boxes, scene);
-  nodes_[index].first = build(mid, end, centroids, boxes, scene);
+  build(begin, mid, centroids, ranges, index);
+  nodes_[index].first = build(mid, end, centroids, ranges, index);
   return index;
 }
 
@@ -141,25 +151,44 @@ double NearestPrimitive::squaredDistanceTo(uint32_t slot, const Vec3& p, double 
   return dot(d, d);
 }
 
+// From the seed's leaf up: at each ancestor, the subtree on the other side is searched (most are pruned by their
+// box alone). Near answers lie in near subtrees, so this tests fewer boxes than a descent from the root.
 NearestHit NearestPrimitive::nearestFrom(const Vec3& p, int64_t seed) const {
   if (seed < 0 || uint64_t(seed) >= ids_.size()) return nearest(p);
-  NearestHit best{squaredDistanceTo(slotOf_[size_t(seed)], p, INFINITY), seed};
-  search(p, best);
+  const uint32_t slot = slotOf_[size_t(seed)];
+  NearestHit best{squaredDistanceTo(slot, p, INFINITY), seed};
+  uint32_t node = leafOf_[slot];
+  visitLeaf(nodes_[node], p, best);
+  while (node != 0) {
+    const uint32_t parent = nodes_[node].parent;
+    search(p, best, node == parent + 1 ? nodes_[parent].first : parent + 1);
+    node = parent;
+  }
   return best;
 }
 
 NearestHit NearestPrimitive::nearest(const Vec3& p, double bound2) const {
   NearestHit best;
   best.squaredDistance = bound2;
-  search(p, best);
+  if (!nodes_.empty()) search(p, best, 0);
   if (best.primitive < 0) best.squaredDistance = INFINITY;
   return best;
 }
 
-// Lowers `best` to the nearest primitive within it (ties to the lowest id): every subtree whose box is no farther
-// than the best so far is visited, nearer child first.
-void NearestPrimitive::search(const Vec3& p, NearestHit& best) const {
-  if (nodes_.empty()) return;
+void NearestPrimitive::visitLeaf(const Node& leaf, const Vec3& p, NearestHit& best) const {
+  for (uint32_t s = leaf.first; s < leaf.first + leaf.count; ++s) {
+    const double d2 = squaredDistanceTo(s, p, best.squaredDistance);
+    const int64_t id = ids_[s];
+    if (d2 < best.squaredDistance || (d2 == best.squaredDistance && (best.primitive < 0 || id < best.primitive))) {
+      best.squaredDistance = d2;
+      best.primitive = id;
+    }
+  }
+}
+
+// Lowers `best` to the nearest primitive of the subtree at `root` within it (ties to the lowest id): every subtree
+// whose box is no farther than the best so far is visited, nearer child first.
+void NearestPrimitive::search(const Vec3& p, NearestHit& best, uint32_t root) const {
   // Depth is about log2(n / kLeafSize) + 1 for a median split: 64 holds any 32-bit count. Each waiting subtree
   // keeps its box's squared distance, so that it is tested again without recomputing it.
   struct Waiting {
@@ -168,8 +197,8 @@ void NearestPrimitive::search(const Vec3& p, NearestHit& best) const {
   };
   std::array<Waiting, 64> stack;
   size_t top = 0;
-  uint32_t current = 0;
-  double currentD2 = squaredDistanceToOrientedBox(nodes_[0].box, p);
+  uint32_t current = root;
+  double currentD2 = squaredDistanceToOrientedBox(nodes_[root].box, p);
   for (;;) {
     if (currentD2 <= best.squaredDistance) {
       const Node& node = nodes_[current];
@@ -183,14 +212,7 @@ void NearestPrimitive::search(const Vec3& p, NearestHit& best) const {
         currentD2 = aFirst ? da : db;
         continue;
       }
-      for (uint32_t s = node.first; s < node.first + node.count; ++s) {
-        const double d2 = squaredDistanceTo(s, p, best.squaredDistance);
-        const int64_t id = ids_[s];
-        if (d2 < best.squaredDistance || (d2 == best.squaredDistance && (best.primitive < 0 || id < best.primitive))) {
-          best.squaredDistance = d2;
-          best.primitive = id;
-        }
-      }
+      visitLeaf(node, p, best);
     }
     if (top == 0) return;
     --top;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "vox/core/error.h"
+#include "vox/distance/centre_signs.h"
 #include "vox/distance/nearest.h"
 #include "vox/distance/sdf.h"
 
@@ -23,12 +24,13 @@ namespace {
 struct QueryProgress {
   const DistanceQueryOptions& options;
   uint64_t total;
+  double from = 0;  // the part of options.progress this loop reports: [from, 1]
   std::atomic<uint64_t> done{0};
   std::atomic<bool> cancelled{false};
   void report(uint64_t count) {
     const uint64_t finished = done += count;
-    if (options.progress && !options.progress(double(finished) / double(std::max<uint64_t>(total, 1))))
-      cancelled = true;
+    const double f = double(finished) / double(std::max<uint64_t>(total, 1));
+    if (options.progress && !options.progress(from + (1 - from) * f)) cancelled = true;
   }
 };
 
@@ -37,14 +39,16 @@ struct QueryProgress {
 void denseSignedDistances(const Grid& grid, const Scene& scene, std::span<double> out,
                           const std::array<uint64_t, 3>& strides, const DistanceQueryOptions& options) {
   const NearestPrimitive nearest(scene);
-  const InsideTest insideTest(scene);
+  std::function<bool(double)> signProgress;
+  if (options.progress) signProgress = [&](double f) { return options.progress(0.1 * f); };
+  const std::vector<uint8_t> centreInside = occupiedCentresInside(grid, scene, signProgress);
   const std::array<std::vector<double>, 3> centres = cellCentresByAxis(grid);
   // Rows run along the axis of the smallest stride, so each row's writes are adjacent and each cell's search is
   // bounded by its neighbour's distance.
   const int along = strides[0] <= strides[1] && strides[0] <= strides[2] ? 0 : (strides[1] <= strides[2] ? 1 : 2);
   const int u = along == 0 ? 1 : 0, v = along == 2 ? 1 : 2;
   const uint64_t rows = uint64_t(grid.dims[u]) * grid.dims[v], length = grid.dims[along];
-  QueryProgress progress{options, rows};
+  QueryProgress progress{options, rows, 0.1};
   tbb::parallel_for(tbb::blocked_range<uint64_t>(0, rows, 16), [&](const tbb::blocked_range<uint64_t>& r) {
     if (progress.cancelled) return;
     for (uint64_t row = r.begin(); row < r.end(); ++row) {
@@ -59,7 +63,8 @@ void denseSignedDistances(const Grid& grid, const Scene& scene, std::span<double
         previous = hit.primitive;
         const double d = std::sqrt(hit.squaredDistance);
         const uint64_t key = cellKey(grid.dims, ijk[0], ijk[1], ijk[2]);
-        const bool inside = findCell(grid, key) >= 0 ? d > 0 && insideTest.inside(c) : isSolid(grid, key);
+        const int64_t cell = findCell(grid, key);
+        const bool inside = cell >= 0 ? d > 0 && centreInside[size_t(cell)] : isSolid(grid, key);
         out[ijk[0] * strides[0] + ijk[1] * strides[1] + ijk[2] * strides[2]] = inside ? -d : d;
       }
     }

@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "vox/core/error.h"
+#include "vox/distance/centre_signs.h"
 #include "vox/voxelize/fill.h"
 
 namespace vox {
@@ -186,7 +187,9 @@ SdfBand signedDistanceBand(const Grid& grid, const Scene& scene, const SdfOption
   for (const Candidate& c : all) band.keys.push_back(c.key), band.values.push_back(c.d2);
   std::vector<Candidate>().swap(all);
   // Signs: an empty cell lies wholly on one side, which the fill decided; an occupied cell's centre is tested.
-  const InsideTest insideTest(scene);
+  std::function<bool(double)> signProgress;
+  if (options.progress) signProgress = [&](double f) { return options.progress(0.8 + 0.15 * f); };
+  const std::vector<uint8_t> centreInside = occupiedCentresInside(grid, scene, signProgress);
   std::atomic<uint64_t> done{0};
   std::atomic<bool> cancelled{false};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, band.keys.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
@@ -194,16 +197,12 @@ SdfBand signedDistanceBand(const Grid& grid, const Scene& scene, const SdfOption
     for (size_t b = r.begin(); b < r.end(); ++b) {
       const uint64_t key = band.keys[b];
       const double d = std::sqrt(band.values[b]);
-      bool inside;
-      if (findCell(grid, key) >= 0) {
-        inside = d > 0 && insideTest.inside(cellCentre(grid, key));
-      } else {
-        inside = isSolid(grid, key);
-      }
+      const int64_t cell = findCell(grid, key);
+      const bool inside = cell >= 0 ? d > 0 && centreInside[size_t(cell)] : isSolid(grid, key);
       band.values[b] = inside ? -d : d;
     }
     const uint64_t finished = done += r.size();
-    if (options.progress && !options.progress(0.8 + 0.2 * double(finished) / double(band.keys.size())))
+    if (options.progress && !options.progress(0.95 + 0.05 * double(finished) / double(band.keys.size())))
       cancelled = true;
   });
   if (cancelled) fail<Error>("signed distances cancelled");

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <array>
 
-#include "volume/exact_orient.h"
+#include "vox/core/exact_orient.h"
 
 namespace vox::volume {
 

@@ -46,18 +46,21 @@ class NearestPrimitive {
  private:
   struct Node {
     OrientedBox box;
-    uint32_t first = 0;  // leaf: its first primitive slot; inner: the second child (the first is the next node)
-    uint32_t count = 0;  // primitives of a leaf; 0 for an inner node
+    uint32_t first = 0;   // leaf: its first primitive slot; inner: the second child (the first is the next node)
+    uint32_t count = 0;   // primitives of a leaf; 0 for an inner node
+    uint32_t parent = 0;  // the root's is itself
   };
   double squaredDistanceTo(uint32_t slot, const Vec3& p, double bound2) const;
-  void search(const Vec3& p, NearestHit& best) const;
-  uint32_t build(uint32_t begin, uint32_t end, std::vector<Vec3>& centroids, std::vector<Box>& boxes,
-                 const Scene& scene);
+  void search(const Vec3& p, NearestHit& best, uint32_t root) const;
+  void visitLeaf(const Node& leaf, const Vec3& p, NearestHit& best) const;
+  uint32_t build(uint32_t begin, uint32_t end, const std::vector<Vec3>& centroids,
+                 std::vector<std::array<uint32_t, 2>>& ranges, uint32_t parent);
   OrientedBox orientedBounds(uint32_t begin, uint32_t end, const Scene& scene, const std::vector<Box>& boxes) const;
 
   std::vector<Node> nodes_;
   std::vector<uint32_t> ids_;               // slot -> primitive id, in leaf order
   std::vector<uint32_t> slotOf_;            // primitive id -> slot
+  std::vector<uint32_t> leafOf_;            // slot -> its leaf node
   std::vector<Triangle> triangles_;         // by slot (unused slots of spheres hold nothing useful)
   std::vector<TriangleLowerBound> bounds_;  // by slot, of triangles
   std::vector<EllipsoidShape> shapes_;      // by sphere index

@@ -105,12 +105,15 @@ const std::vector<SectionCodec>& sectionCodecs() {
 void putSections(ByteWriter& w, const Scene& scene, const Grid& grid) {
   for (const SectionCodec& codec : sectionCodecs()) {
     if (!codec.has(scene, grid)) continue;
-    // The body is encoded apart first: its size comes before it, and a streaming writer cannot go back.
-    ByteWriter body;
-    codec.put(body, scene, grid);
+    // Its size comes before it, and a streaming writer cannot go back: the body is encoded twice, first only to
+    // count its bytes (a copy of a section of hundreds of MB, grown by appending, took seconds).
+    uint64_t size = 0;
+    ByteWriter counter([&](std::string_view bytes) { size += bytes.size(); });
+    codec.put(counter, scene, grid);
+    counter.finish();
     w.put(uint32_t(codec.tag));
-    w.put(uint64_t(body.bytes().size()));
-    w.putBytes(body.bytes());
+    w.put(size);
+    codec.put(w, scene, grid);
   }
 }
 

@@ -14,7 +14,7 @@ bool hasDistancesSection(const Scene&, const Grid& grid) { return grid.sdfHalfWi
 void putDistancesSection(ByteWriter& w, const Scene&, const Grid& grid) {
   w.put(grid.sdfHalfWidth);
   w.putArray(grid.sdfKeys);
-  for (double v : grid.sdfValues) w.put(v);
+  w.putBytes({reinterpret_cast<const char*>(grid.sdfValues.data()), grid.sdfValues.size() * sizeof(double)});
 }
 
 void getDistancesSection(ByteReader& r, Scene&, Grid& grid) {

@@ -194,11 +194,21 @@ SdfBand signedDistanceBand(const Grid& grid, const Scene& scene, const SdfOption
   std::atomic<bool> cancelled{false};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, band.keys.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
     if (cancelled) return;
+    // The band's keys ascend, as do the occupied cells' and the solid runs': one search each per block, then walks.
+    size_t cell = std::lower_bound(grid.cellKeys.begin(), grid.cellKeys.end(), band.keys[r.begin()]) -
+                  grid.cellKeys.begin();
+    size_t run = std::upper_bound(grid.solidRuns.begin(), grid.solidRuns.end(), band.keys[r.begin()],
+                                  [](uint64_t k, const CellRun& s) { return k < s.first; }) -
+                 grid.solidRuns.begin();
+    run = run > 0 ? run - 1 : 0;  // the run that may hold the first key
     for (size_t b = r.begin(); b < r.end(); ++b) {
       const uint64_t key = band.keys[b];
       const double d = std::sqrt(band.values[b]);
-      const int64_t cell = findCell(grid, key);
-      const bool inside = cell >= 0 ? d > 0 && centreInside[size_t(cell)] : isSolid(grid, key);
+      while (cell < grid.cellKeys.size() && grid.cellKeys[cell] < key) ++cell;
+      while (run < grid.solidRuns.size() && grid.solidRuns[run].first + grid.solidRuns[run].count <= key) ++run;
+      const bool occupied = cell < grid.cellKeys.size() && grid.cellKeys[cell] == key;
+      const bool solid = run < grid.solidRuns.size() && grid.solidRuns[run].first <= key;
+      const bool inside = occupied ? d > 0 && centreInside[cell] : solid;
       band.values[b] = inside ? -d : d;
     }
     const uint64_t finished = done += r.size();

@@ -23,6 +23,8 @@
 #include "vox/core/grid.h"
 #include "vox/core/scene.h"
 #include "vox/io/grid_file.h"
+#include "vox/distance/nearest.h"
+#include "vox/distance/sdf.h"
 #include "vox/trace/accel.h"
 
 namespace voxpy {
@@ -44,12 +46,19 @@ class PyGrid {
   const std::string& source() const { return source_; }
   // The Accel of the grid walk, built once (thread-safe); call with the GIL released, it can take a while.
   const vox::Accel& accel();
+  // Grid.distance's search structure and inside test, each built on first use (thread-safe) and kept, as a
+  // RaycastingScene keeps Open3D's: later calls only query.
+  const vox::NearestPrimitive& nearest();
+  const vox::InsideTest& insideTest();
 
  private:
   std::shared_ptr<const vox::GridFile> file_;
   std::string source_;
   std::once_flag accelOnce_;
   std::unique_ptr<vox::Accel> accel_;
+  std::once_flag nearestOnce_, insideOnce_;
+  std::unique_ptr<vox::NearestPrimitive> nearest_;
+  std::unique_ptr<vox::InsideTest> insideTest_;
 };
 
 // ---- Long calls (call.cpp) ----

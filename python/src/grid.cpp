@@ -20,6 +20,16 @@ const vox::Accel& PyGrid::accel() {
   return *accel_;
 }
 
+const vox::NearestPrimitive& PyGrid::nearest() {
+  std::call_once(nearestOnce_, [&] { nearest_ = std::make_unique<vox::NearestPrimitive>(file_->scene); });
+  return *nearest_;
+}
+
+const vox::InsideTest& PyGrid::insideTest() {
+  std::call_once(insideOnce_, [&] { insideTest_ = std::make_unique<vox::InsideTest>(file_->scene); });
+  return *insideTest_;
+}
+
 namespace {
 
 using vox::Grid;

@@ -109,24 +109,35 @@ std::vector<uint32_t> spatialOrder(std::span<const double> points) {
   return order;
 }
 
+void checkPoints(std::span<const double> points) {
+  for (size_t i = 0; i < points.size(); ++i)
+    if (!std::isfinite(points[i]))
+      fail<InputError>("points[", i / 3, ", ", i % 3, "] is ", points[i], ": coordinates must be finite");
+  if (points.size() / 3 > UINT32_MAX)
+    fail<LimitError>("point distances: ", points.size() / 3, " points, more than 2^32 - 1 in one call");
+}
+
 }  // namespace
 
 void pointDistances(const Scene& scene, std::span<const double> points, bool signedDistance,
                     const PointDistanceOutput& out, const DistanceQueryOptions& options) {
-  const size_t n = points.size() / 3;
-  for (size_t i = 0; i < points.size(); ++i)
-    if (!std::isfinite(points[i]))
-      fail<InputError>("points[", i / 3, ", ", i % 3, "] is ", points[i], ": coordinates must be finite");
-  if (n > UINT32_MAX) fail<LimitError>("point distances: ", n, " points, more than 2^32 - 1 in one call");
+  checkPoints(points);
   const NearestPrimitive nearest(scene);
   std::optional<InsideTest> insideTest;
   if (signedDistance) insideTest.emplace(scene);
+  pointDistances(nearest, insideTest ? &*insideTest : nullptr, points, out, options);
+}
+
+void pointDistances(const NearestPrimitive& nearest, const InsideTest* insideTest, std::span<const double> points,
+                    const PointDistanceOutput& out, const DistanceQueryOptions& options) {
+  checkPoints(points);
+  const size_t n = points.size() / 3;
   const std::vector<uint32_t> order = spatialOrder(points);
   QueryProgress progress{options, n};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024), [&](const tbb::blocked_range<size_t>& r) {
     if (progress.cancelled) return;
-    int64_t previous =
-        -1;  // the nearest primitive of the point before in spatial order: this one's search starts there
+    // The nearest primitive of the point before in spatial order: this one's search starts there.
+    int64_t previous = -1;
     for (size_t k = r.begin(); k < r.end(); ++k) {
       const size_t i = order[k];
       const Vec3 p{points[3 * i], points[3 * i + 1], points[3 * i + 2]};

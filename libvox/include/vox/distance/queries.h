@@ -10,6 +10,8 @@
 
 #include "vox/core/grid.h"
 #include "vox/core/scene.h"
+#include "vox/distance/nearest.h"
+#include "vox/distance/sdf.h"
 
 namespace vox {
 
@@ -37,6 +39,10 @@ struct PointDistanceOutput {
   std::span<double> closest;
 };
 void pointDistances(const Scene& scene, std::span<const double> points, bool signedDistance,
+                    const PointDistanceOutput& out, const DistanceQueryOptions& options = {});
+// The same with the search structure and the inside test built by the caller (and kept across calls): `inside`
+// null for unsigned distances.
+void pointDistances(const NearestPrimitive& nearest, const InsideTest* inside, std::span<const double> points,
                     const PointDistanceOutput& out, const DistanceQueryOptions& options = {});
 
 }  // namespace vox

@@ -25,6 +25,9 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <span>
+#include <utility>
+#include <vector>
 
 #include "vox/core/error.h"
 #include "vox/voxelize/open_edges.h"
@@ -104,47 +107,69 @@ struct LineTable {
   bool unclosed = false;  // some line ends with w != 0: the grid misses triangles of the scene
 };
 
-struct LinePrim {
-  uint64_t line;
-  uint32_t prim;
-  bool operator<(const LinePrim& o) const { return line != o.line ? line < o.line : prim < o.prim; }
-  bool operator==(const LinePrim& o) const { return line == o.line && prim == o.prim; }
+// The triangles of each column of cells (i, j), any k: sorted, each once.
+struct ColumnTable {
+  std::vector<uint64_t> keys;  // column i + nx j, ascending
+  std::vector<size_t> start;   // prims of keys[g]: prims[start[g] .. start[g + 1])
+  std::vector<uint32_t> prims;
+  std::span<const uint32_t> of(uint64_t column) const {
+    const auto it = std::lower_bound(keys.begin(), keys.end(), column);
+    if (it == keys.end() || *it != column) return {};
+    const size_t g = size_t(it - keys.begin());
+    return {prims.data() + start[g], prims.data() + start[g + 1]};
+  }
 };
 
-// Which triangles may cross each needed line: those of the four cell columns around it (a triangle crossing the
-// line at height z meets the closed cells there), and those sticking out of the grid.
-std::vector<LinePrim> linePrims(const Grid& grid, const Scene& scene, const std::vector<uint64_t>& needed) {
-  const uint64_t nx1 = uint64_t(grid.dims[0]) + 1;
-  const size_t nTri = scene.triangles.size();
-  const auto isNeeded = [&](uint64_t key) { return std::binary_search(needed.begin(), needed.end(), key); };
-  tbb::enumerable_thread_specific<std::vector<LinePrim>> locals;
+ColumnTable columnPrims(const Grid& grid, size_t nTri) {
+  tbb::enumerable_thread_specific<std::vector<std::pair<uint64_t, uint32_t>>> locals;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, grid.cellKeys.size(), 1024), [&](const auto& r) {
-    std::vector<LinePrim>& out = locals.local();
+    auto& out = locals.local();
     for (size_t c = r.begin(); c < r.end(); ++c) {
-      const auto ijk = cellIndex(grid.dims, grid.cellKeys[c]);
-      for (uint64_t b = ijk[1]; b <= uint64_t(ijk[1]) + 1; ++b)
-        for (uint64_t a = ijk[0]; a <= uint64_t(ijk[0]) + 1; ++a) {
-          const uint64_t key = a + nx1 * b;
-          if (!isNeeded(key)) continue;
-          for (const uint32_t p : grid.cellPrims(c))
-            if (p < nTri) out.push_back({key, p});
-        }
+      const uint64_t column = grid.cellKeys[c] % (uint64_t(grid.dims[0]) * grid.dims[1]);
+      for (const uint32_t p : grid.cellPrims(c))
+        if (p < nTri) out.push_back({column, p});
     }
   });
-  std::vector<LinePrim> pairs;
+  std::vector<std::pair<uint64_t, uint32_t>> pairs;
   for (const auto& local : locals) pairs.insert(pairs.end(), local.begin(), local.end());
-  for (const uint32_t p : grid.outsidePrims) {
-    if (p >= nTri) continue;
-    const Box b = triangleBounds(scene.triangles[p]);
-    for (const uint64_t key : needed) {  // rare (user bounds cutting the scene): a plain scan
-      const double X = cellBoundary(grid.bounds, grid.dims, 0, int64_t(key % nx1));
-      const double Y = cellBoundary(grid.bounds, grid.dims, 1, int64_t(key / nx1));
-      if (X >= b.lo.x && X <= b.hi.x && Y >= b.lo.y && Y <= b.hi.y) pairs.push_back({key, p});
-    }
-  }
   tbb::parallel_sort(pairs.begin(), pairs.end());
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-  return pairs;
+  ColumnTable t;
+  t.prims.reserve(pairs.size());
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    if (i == 0 || pairs[i].first != pairs[i - 1].first) {
+      t.keys.push_back(pairs[i].first);
+      t.start.push_back(i);
+    }
+    t.prims.push_back(pairs[i].second);
+  }
+  t.start.push_back(pairs.size());
+  return t;
+}
+
+// Which triangles may cross line a + (nx + 1) b: those of the four cell columns around it (a triangle crossing the
+// line at height z meets the closed cells there), and those sticking out of the grid (rare: user bounds cutting the
+// scene, a box test each). Sorted, each once, into `out`.
+void linePrims(const Grid& grid, const Scene& scene, const ColumnTable& columns, uint64_t line,
+               std::vector<uint32_t>& out) {
+  const uint64_t nx = grid.dims[0], ny = grid.dims[1], a = line % (nx + 1), b = line / (nx + 1);
+  out.clear();
+  for (uint64_t j = b > 0 ? b - 1 : 0; j <= b && j < ny; ++j)
+    for (uint64_t i = a > 0 ? a - 1 : 0; i <= a && i < nx; ++i) {
+      const std::span<const uint32_t> prims = columns.of(i + nx * j);
+      out.insert(out.end(), prims.begin(), prims.end());
+    }
+  if (!grid.outsidePrims.empty()) {
+    const double X = cellBoundary(grid.bounds, grid.dims, 0, int64_t(a));
+    const double Y = cellBoundary(grid.bounds, grid.dims, 1, int64_t(b));
+    for (const uint32_t p : grid.outsidePrims) {
+      if (p >= scene.triangles.size()) continue;
+      const Box box = triangleBounds(scene.triangles[p]);
+      if (X >= box.lo.x && X <= box.hi.x && Y >= box.lo.y && Y <= box.hi.y) out.push_back(p);
+    }
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
 }
 
 LineTable buildLines(const Grid& grid, const Scene& scene, const FractionOptions& options, Progress& progress) {
@@ -162,14 +187,20 @@ LineTable buildLines(const Grid& grid, const Scene& scene, const FractionOptions
   if (bytes > double(options.memoryLimitBytes))
     fail<LimitError>("volume fractions: the cell lines' crossings need ", uint64_t(bytes) >> 20, " MiB, more than the ",
                      options.memoryLimitBytes >> 20, " MiB allowed");
-  const std::vector<LinePrim> pairs = linePrims(grid, scene, needed);
-  for (size_t i = 0; i < pairs.size(); ++i)
-    if (i == 0 || pairs[i].line != pairs[i - 1].line) {
-      table.keys.push_back(pairs[i].line);
-      table.start.push_back(i);
+  const ColumnTable columns = columnPrims(grid, scene.triangles.size());
+  // Each line's slots: as many as triangles may cross it (compacted to the crossings below).
+  table.keys = std::move(needed);
+  table.start.assign(table.keys.size() + 1, 0);
+  tbb::enumerable_thread_specific<std::vector<uint32_t>> scratch;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, table.keys.size(), 256), [&](const auto& r) {
+    std::vector<uint32_t>& prims = scratch.local();
+    for (size_t g = r.begin(); g < r.end(); ++g) {
+      linePrims(grid, scene, columns, table.keys[g], prims);
+      table.start[g + 1] = prims.size();
     }
-  table.start.push_back(pairs.size());
-  table.crossings.resize(pairs.size());
+  });
+  for (size_t g = 0; g < table.keys.size(); ++g) table.start[g + 1] += table.start[g];
+  table.crossings.resize(table.start.back());
   std::vector<size_t> counts(table.keys.size());
   std::atomic<int> minW{0}, maxW{0};
   std::atomic<bool> unclosed{false};
@@ -180,8 +211,10 @@ LineTable buildLines(const Grid& grid, const Scene& scene, const FractionOptions
       const double Y = cellBoundary(grid.bounds, grid.dims, 1, int64_t(table.keys[g] / nx1));
       Crossing* out = table.crossings.data() + table.start[g];
       size_t n = 0;
-      for (size_t i = table.start[g]; i < table.start[g + 1]; ++i)
-        if (const auto c = volume::lineCrossing(scene.triangles[pairs[i].prim], X, Y, grid.bounds.lo.z))
+      std::vector<uint32_t>& prims = scratch.local();
+      linePrims(grid, scene, columns, table.keys[g], prims);
+      for (const uint32_t p : prims)
+        if (const auto c = volume::lineCrossing(scene.triangles[p], X, Y, grid.bounds.lo.z))
           out[n++] = {c->z, c->jump, 0};
       std::sort(out, out + n);
       int w = 0, lo = 0, hi = 0;

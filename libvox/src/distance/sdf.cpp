@@ -79,8 +79,9 @@ struct TilePrim {
   bool operator<(const TilePrim& o) const { return tile != o.tile ? tile < o.tile : prim < o.prim; }
 };
 
-// The band's cells with their nearest squared distance, in no particular order.
-std::vector<Candidate> bandCandidates(const Grid& grid, const Scene& scene, double reach, const SdfOptions& options) {
+// The band's cells with their nearest squared distance, in pieces whose concatenation is in key order.
+std::vector<std::vector<Candidate>> bandCandidates(const Grid& grid, const Scene& scene, double reach,
+                                                   const SdfOptions& options) {
   const std::array<std::vector<double>, 3> centres = cellCentresByAxis(grid);
   std::vector<EllipsoidShape> shapes;
   for (const Sphere& s : scene.spheres) shapes.push_back(ellipsoidShape(s));
@@ -119,19 +120,28 @@ std::vector<Candidate> bandCandidates(const Grid& grid, const Scene& scene, doub
   for (size_t b = 0; b < bins.size(); ++b)
     if (b == 0 || bins[b].tile != bins[b - 1].tile) starts.push_back(b);
   starts.push_back(bins.size());
-  // Tiles.
-  tbb::enumerable_thread_specific<std::vector<Candidate>> locals;
+  // Tiles, a slab of whole z planes of tiles at a time: a slab's cells, sorted, are a contiguous stretch of the
+  // band in key order, so the band is their concatenation and no array of all of them is ever sorted or copied.
+  std::vector<std::array<size_t, 2>> slabs;  // [first, end) of `starts` indices
+  for (size_t g = 0; g + 1 < starts.size(); ++g) {
+    const uint64_t slab = bins[starts[g]].tile / (tiles[0] * tiles[1]);
+    if (slabs.empty() || bins[starts[slabs.back()[0]]].tile / (tiles[0] * tiles[1]) != slab)
+      slabs.push_back({g, g + 1});
+    else
+      slabs.back()[1] = g + 1;
+  }
+  std::vector<std::vector<Candidate>> pieces(slabs.size());
   std::atomic<uint64_t> done{0}, emitted{0};
   std::atomic<bool> cancelled{false}, overBudget{false};
   const uint64_t maxCells = options.memoryLimitBytes / (2 * sizeof(Candidate));
   const double reach2 = reach * reach;
   const size_t tileCount = starts.size() - 1;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, tileCount, 4), [&](const tbb::blocked_range<size_t>& r) {
-    if (cancelled || overBudget) return;
-    std::vector<Candidate>& out = locals.local();
-    const size_t before = out.size();
+  tbb::parallel_for(size_t(0), slabs.size(), [&](size_t slab) {
+    std::vector<Candidate>& out = pieces[slab];
     std::vector<double> nearest(size_t(kTile) * kTile * kTile);
-    for (size_t g = r.begin(); g < r.end(); ++g) {
+    for (size_t g = slabs[slab][0]; g < slabs[slab][1]; ++g) {
+      if (cancelled || overBudget) return;
+      const size_t before = out.size();
       const uint64_t tile = bins[starts[g]].tile;
       const int64_t t0[3] = {int64_t(tile % tiles[0]) * kTile, int64_t(tile / tiles[0] % tiles[1]) * kTile,
                              int64_t(tile / (tiles[0] * tiles[1])) * kTile};
@@ -158,20 +168,18 @@ std::vector<Candidate> bandCandidates(const Grid& grid, const Scene& scene, doub
             const double d2 = nearest[i + kTile * (j + kTile * k)];
             if (d2 <= reach2) out.push_back({cellKey(grid.dims, t0[0] + i, t0[1] + j, t0[2] + k), d2});
           }
+      if ((emitted += out.size() - before) > maxCells) overBudget = true;
+      const uint64_t finished = ++done;
+      if (options.progress && !options.progress(0.8 * double(finished) / double(tileCount))) cancelled = true;
     }
-    if ((emitted += out.size() - before) > maxCells) overBudget = true;
-    const uint64_t finished = done += r.size();
-    if (options.progress && !options.progress(0.8 * double(finished) / double(tileCount))) cancelled = true;
+    std::sort(out.begin(), out.end());  // tiles are disjoint: each key comes once
   });
   if (cancelled) fail<Error>("signed distances cancelled");
   if (overBudget)
     fail<LimitError>("signed distance band: more than ", maxCells, " cells within ", options.halfWidth,
                      " cell widths, over the memory limit of ", options.memoryLimitBytes >> 20,
                      " MiB; use a narrower band or fewer cells");
-  std::vector<Candidate> all;
-  all.reserve(emitted);
-  for (auto& local : locals) all.insert(all.end(), local.begin(), local.end());
-  return all;
+  return pieces;
 }
 
 }  // namespace
@@ -179,13 +187,16 @@ std::vector<Candidate> bandCandidates(const Grid& grid, const Scene& scene, doub
 SdfBand signedDistanceBand(const Grid& grid, const Scene& scene, const SdfOptions& options) {
   checkSdfHalfWidth(options.halfWidth, "--sdf");
   const double reach = options.halfWidth * smallestCellEdge(grid);
-  std::vector<Candidate> all = bandCandidates(grid, scene, reach, options);
-  tbb::parallel_sort(all.begin(), all.end());  // tiles are disjoint: each key comes once
+  std::vector<std::vector<Candidate>> pieces = bandCandidates(grid, scene, reach, options);
+  size_t total = 0;
+  for (const auto& piece : pieces) total += piece.size();
   SdfBand band;
-  band.keys.reserve(all.size());
-  band.values.reserve(all.size());
-  for (const Candidate& c : all) band.keys.push_back(c.key), band.values.push_back(c.d2);
-  std::vector<Candidate>().swap(all);
+  band.keys.reserve(total);
+  band.values.reserve(total);
+  for (auto& piece : pieces) {  // each piece freed once copied: the band and its pieces are never both whole
+    for (const Candidate& c : piece) band.keys.push_back(c.key), band.values.push_back(c.d2);
+    std::vector<Candidate>().swap(piece);
+  }
   // Signs: an empty cell lies wholly on one side, which the fill decided; an occupied cell's centre is tested.
   std::function<bool(double)> signProgress;
   if (options.progress) signProgress = [&](double f) { return options.progress(0.8 + 0.15 * f); };
@@ -195,8 +206,8 @@ SdfBand signedDistanceBand(const Grid& grid, const Scene& scene, const SdfOption
   tbb::parallel_for(tbb::blocked_range<size_t>(0, band.keys.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
     if (cancelled) return;
     // The band's keys ascend, as do the occupied cells' and the solid runs': one search each per block, then walks.
-    size_t cell = std::lower_bound(grid.cellKeys.begin(), grid.cellKeys.end(), band.keys[r.begin()]) -
-                  grid.cellKeys.begin();
+    size_t cell =
+        std::lower_bound(grid.cellKeys.begin(), grid.cellKeys.end(), band.keys[r.begin()]) - grid.cellKeys.begin();
     size_t run = std::upper_bound(grid.solidRuns.begin(), grid.solidRuns.end(), band.keys[r.begin()],
                                   [](uint64_t k, const CellRun& s) { return k < s.first; }) -
                  grid.solidRuns.begin();

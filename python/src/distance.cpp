@@ -22,9 +22,8 @@ py::tuple distance(PyGrid& self, const py::handle& points, const py::object& sig
   vox::DistanceQueryOptions o;
   o.progress = [&](double f) { return interrupt.poll(f); };
   const std::span<const double> flat(&q.data()->x, 3 * q.size());  // Vec3 is three adjacent doubles
-  runLong(interrupt, nThreads, [&] {
-    vox::pointDistances(self.nearest(), isSigned ? &self.insideTest() : nullptr, flat, out, o);
-  });
+  runLong(interrupt, nThreads,
+          [&] { vox::pointDistances(self.nearest(), isSigned ? &self.insideTest() : nullptr, flat, out, o); });
   if (!self.scene().planes.empty())
     warn(self.source() + ": " + std::to_string(self.scene().planes.size()) + " planes are left out of the distances");
   return py::make_tuple(d, primitive, closest);

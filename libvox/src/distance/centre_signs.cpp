@@ -21,8 +21,8 @@ namespace vox {
 namespace {
 
 // As the fill's hole caps: more boundaries than this make a soup, where each centre asks the whole mesh's tree.
-constexpr size_t kMaxBoundaries = 64;
-constexpr double kByIntegerAlone = 0.45;
+constexpr size_t kMaxCapBoundaries = 64;
+constexpr double kCapBoundForInteger = 0.45;
 
 // Sign of orient2d(u, v, q) in the (y, z) plane with q moved to (qy + e, qz + e^2), e infinitesimal: the rounded-off
 // first-order terms decide where q lies on the line through u and v. 0 only when u and v project to one point.
@@ -36,7 +36,7 @@ int perturbedOrient(const Vec3& u, const Vec3& v, double qy, double qz) {
 
 // Whether the line (y, z) = (qy, qz) along x, perturbed as above, crosses triangle t: the sign of the x component
 // of its normal (b - a) x (c - a) when it does, 0 when it misses. A triangle edge-on to x is always missed.
-int lineCrossing(const Triangle& t, double qy, double qz) {
+int rowLineCrossing(const Triangle& t, double qy, double qz) {
   const Vec3 &a = t.v[0], &b = t.v[1], &c = t.v[2];
   if (qy < std::min({a.y, b.y, c.y}) || qy > std::max({a.y, b.y, c.y}) || qz < std::min({a.z, b.z, c.z}) ||
       qz > std::max({a.z, b.z, c.z}))
@@ -48,13 +48,13 @@ int lineCrossing(const Triangle& t, double qy, double qz) {
   return o;
 }
 
-struct Crossing {
+struct RowCrossing {
   const Triangle* triangle;
   int sign;  // of the normal's x component
 };
 
 // The caps that close the mesh's holes, with their winding tree.
-struct Caps {
+struct CapWinding {
   std::vector<OpenBoundary> boundaries;
   WindingTree tree;
   // s at p, close enough to decide |k - s| >= kWindingThreshold as the exact value does (the fill's margin).
@@ -71,7 +71,7 @@ struct Caps {
       }
       bound += d2 > 0 ? b.capArea / (4 * std::numbers::pi * d2) : INFINITY;
     }
-    if (bound < kByIntegerAlone) return 0;
+    if (bound < kCapBoundForInteger) return 0;
     constexpr double kRefineMargin = 0.05, kRefineBeta = 8;
     const double s = windingNumber(tree, p);
     if (std::abs(std::abs(double(k) - s) - kWindingThreshold) >= kRefineMargin) return s;
@@ -94,7 +94,7 @@ std::vector<std::pair<size_t, size_t>> occupiedRows(const Grid& grid) {
 }
 
 template <typename Body>
-void forEachBlock(size_t count, const std::function<bool(double)>& progress, const Body& body) {
+void forEachCentreBlock(size_t count, const std::function<bool(double)>& progress, const Body& body) {
   std::atomic<size_t> done{0};
   std::atomic<bool> cancelled{false};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 256), [&](const tbb::blocked_range<size_t>& r) {
@@ -111,10 +111,10 @@ void forEachBlock(size_t count, const std::function<bool(double)>& progress, con
 std::vector<uint8_t> occupiedCentresInside(const Grid& grid, const Scene& scene,
                                            const std::function<bool(double)>& progress) {
   std::vector<uint8_t> inside(grid.occupiedCount(), 0);
-  std::optional<Caps> caps;
+  std::optional<CapWinding> caps;
   if (grid.method != OverlapMethod::Center && grid.outsidePrims.empty()) {
-    std::vector<OpenBoundary> boundaries = openBoundaries(scene.triangles, nullptr, kMaxBoundaries);
-    if (boundaries.size() <= kMaxBoundaries) {
+    std::vector<OpenBoundary> boundaries = openBoundaries(scene.triangles, nullptr, kMaxCapBoundaries);
+    if (boundaries.size() <= kMaxCapBoundaries) {
       caps.emplace();
       std::vector<Triangle> capTriangles;
       for (const OpenBoundary& b : boundaries) capTriangles.insert(capTriangles.end(), b.cap.begin(), b.cap.end());
@@ -125,7 +125,7 @@ std::vector<uint8_t> occupiedCentresInside(const Grid& grid, const Scene& scene,
   const std::array<std::vector<double>, 3> centres = cellCentresByAxis(grid);
   if (!caps) {  // no exact count: the whole mesh's tree at each centre
     const InsideTest insideTest(scene);
-    forEachBlock(inside.size(), progress, [&](const tbb::blocked_range<size_t>& r) {
+    forEachCentreBlock(inside.size(), progress, [&](const tbb::blocked_range<size_t>& r) {
       for (size_t c = r.begin(); c < r.end(); ++c) inside[c] = insideTest.inside(cellCentre(grid, grid.cellKeys[c]));
     });
     return inside;
@@ -133,9 +133,9 @@ std::vector<uint8_t> occupiedCentresInside(const Grid& grid, const Scene& scene,
   std::vector<EllipsoidShape> shapes;
   for (const Sphere& s : scene.spheres) shapes.push_back(ellipsoidShape(s));
   const std::vector<std::pair<size_t, size_t>> rows = occupiedRows(grid);
-  forEachBlock(rows.size(), progress, [&](const tbb::blocked_range<size_t>& r) {
+  forEachCentreBlock(rows.size(), progress, [&](const tbb::blocked_range<size_t>& r) {
     std::vector<uint32_t> ids;
-    std::vector<Crossing> crossings;
+    std::vector<RowCrossing> crossings;
     for (size_t row = r.begin(); row < r.end(); ++row) {
       const auto [first, end] = rows[row];
       const auto ijk = cellIndex(grid.dims, grid.cellKeys[first]);
@@ -148,11 +148,11 @@ std::vector<uint8_t> occupiedCentresInside(const Grid& grid, const Scene& scene,
       ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
       crossings.clear();
       for (const uint32_t id : ids)
-        if (const int s = lineCrossing(scene.triangles[id], qy, qz)) crossings.push_back({&scene.triangles[id], s});
+        if (const int s = rowLineCrossing(scene.triangles[id], qy, qz)) crossings.push_back({&scene.triangles[id], s});
       for (const OpenBoundary& b : caps->boundaries) {
         if (qy < b.bounds.lo.y || qy > b.bounds.hi.y || qz < b.bounds.lo.z || qz > b.bounds.hi.z) continue;
         for (const Triangle& t : b.cap)
-          if (const int s = lineCrossing(t, qy, qz)) crossings.push_back({&t, s});
+          if (const int s = rowLineCrossing(t, qy, qz)) crossings.push_back({&t, s});
       }
       for (size_t c = first; c < end; ++c) {
         const Vec3 p{centres[0][cellIndex(grid.dims, grid.cellKeys[c])[0]], qy, qz};
@@ -162,7 +162,7 @@ std::vector<uint8_t> occupiedCentresInside(const Grid& grid, const Scene& scene,
           // Crossing towards +x a triangle whose normal has x sign s changes the winding number by -s; the crossing
           // lies before p when p is on the side of the plane the normal's x component points to.
           int64_t k = 0;
-          for (const Crossing& x : crossings)
+          for (const RowCrossing& x : crossings)
             if (orient3d(x.triangle->v[0], x.triangle->v[1], x.triangle->v[2], p) == x.sign) k -= x.sign;
           in = std::abs(double(k) - caps->at(p, k)) >= kWindingThreshold;
         }

@@ -43,8 +43,8 @@ void denseSignedDistances(const Grid& grid, const Scene& scene, std::span<double
   if (options.progress) signProgress = [&](double f) { return options.progress(0.1 * f); };
   const std::vector<uint8_t> centreInside = occupiedCentresInside(grid, scene, signProgress);
   const std::array<std::vector<double>, 3> centres = cellCentresByAxis(grid);
-  // Rows run along the axis of the smallest stride, so each row's writes are adjacent and each cell's search is
-  // bounded by its neighbour's distance.
+  // Rows run along the axis of the smallest stride, so each row's writes are adjacent and each cell's search starts
+  // from its neighbour's nearest primitive.
   const int along = strides[0] <= strides[1] && strides[0] <= strides[2] ? 0 : (strides[1] <= strides[2] ? 1 : 2);
   const int u = along == 0 ? 1 : 0, v = along == 2 ? 1 : 2;
   const uint64_t rows = uint64_t(grid.dims[u]) * grid.dims[v], length = grid.dims[along];
@@ -76,7 +76,7 @@ void denseSignedDistances(const Grid& grid, const Scene& scene, std::span<double
 namespace {
 
 // The points' indices in Morton order of their positions quantized to 2^21 steps per axis over their bounding box:
-// consecutive points are then near each other, so each one's search can be bounded by the one before.
+// consecutive points are then near each other, so each one's search can start from the one before's answer.
 std::vector<uint32_t> spatialOrder(std::span<const double> points) {
   const size_t n = points.size() / 3;
   Vec3 lo{INFINITY, INFINITY, INFINITY}, hi = lo * -1.0;

@@ -1,7 +1,8 @@
 // The bounded primitive nearest to any point (DESIGN.md "Distance and volume": Grid.distance, libvox.sdf): a
 // bounding volume hierarchy over the scene's triangles, spheres and ellipsoids (planes are left out), queried depth
-// first, nearer child first, pruned by the squared distance to a node's box. Distances are the ones the --sdf band
-// uses (squaredDistanceToTriangle, closestPointOnEllipsoid), so a dense field equals the band bit for bit.
+// first, nearer child first, pruned by proven lower bounds: each node's oriented box, each triangle's plane and edges
+// (triangleLowerBound). Distances are the ones the --sdf band uses (squaredDistanceToTriangle,
+// closestPointOnEllipsoid), so a dense field equals the band bit for bit.
 #pragma once
 
 #include <cstdint>
@@ -20,8 +21,8 @@ struct NearestHit {
 
 class NearestPrimitive {
  public:
-  // Copies what it needs from `scene` (about 150 bytes per primitive). Throws InputError for a singular sphere
-  // transform (ellipsoidShape).
+  // Copies what it needs from `scene` (about 270 bytes per primitive, with the nodes). Throws InputError for a singular
+  // sphere transform (ellipsoidShape).
   explicit NearestPrimitive(const Scene& scene);
 
   // The primitive nearest to p, ties to the lowest id. `bound2`: a squared distance the caller knows the answer does

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <numbers>
 #include <optional>
 
 #include "vox/core/error.h"
@@ -19,10 +18,6 @@
 namespace vox {
 
 namespace {
-
-// As the fill's hole caps: more boundaries than this make a soup, where each centre asks the whole mesh's tree.
-constexpr size_t kMaxCapBoundaries = 64;
-constexpr double kCapBoundForInteger = 0.45;
 
 // Sign of orient2d(u, v, q) in the (y, z) plane with q moved to (qy + e, qz + e^2), e infinitesimal: the rounded-off
 // first-order terms decide where q lies on the line through u and v. 0 only when u and v project to one point.
@@ -57,25 +52,11 @@ struct RowCrossing {
 struct CapWinding {
   std::vector<OpenBoundary> boundaries;
   WindingTree tree;
-  // s at p, close enough to decide |k - s| >= kWindingThreshold as the exact value does (the fill's margin).
+  // s at p, close enough to decide |k - s| >= kWindingThreshold as the exact value does. Far from every hole the
+  // bound on |s| leaves k alone to decide, and 0 stands in for s.
   double at(const Vec3& p, int64_t k) const {
-    if (tree.nodes.empty()) return 0;
-    // A cap of area A seen from a distance d has |s| <= A / (4 pi d^2): far from every hole, |s| < 0.45 and the
-    // integer k alone decides (|k - s| >= 0.5 exactly when k != 0), so 0 stands in for s.
-    double bound = 0;
-    for (const OpenBoundary& b : boundaries) {
-      double d2 = 0;
-      for (int a = 0; a < 3; ++a) {
-        const double gap = std::max({b.bounds.lo[a] - p[a], p[a] - b.bounds.hi[a], 0.0});
-        d2 += gap * gap;
-      }
-      bound += d2 > 0 ? b.capArea / (4 * std::numbers::pi * d2) : INFINITY;
-    }
-    if (bound < kCapBoundForInteger) return 0;
-    constexpr double kRefineMargin = 0.05, kRefineBeta = 8;
-    const double s = windingNumber(tree, p);
-    if (std::abs(std::abs(double(k) - s) - kWindingThreshold) >= kRefineMargin) return s;
-    return windingNumber(tree, p, kRefineBeta);
+    if (tree.nodes.empty() || capWindingBound(boundaries, Box{p, p}) < kCapBoundForInteger) return 0;
+    return windingNumberToDecide(tree, p, double(k), kWindingThreshold);
   }
 };
 

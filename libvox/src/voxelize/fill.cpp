@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <atomic>
 #include <memory>
-#include <numbers>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -250,12 +249,8 @@ struct SceneWinding {
       if (s.isEllipsoid()) s.transform = inverse(s.transform);
   }
   double at(const Vec3& q) const {
-    // The fast value errs by about 1e-3 (winding_number.h); near the threshold it is recomputed more closely, so
-    // that the decision is the exact one except where the exact value itself is within 1e-3 of the threshold.
-    constexpr double kRefineMargin = 0.05, kRefineBeta = 8;
-    const double w = windingNumber(tree, q);
-    if (std::abs(std::abs(w) - kWindingThreshold) >= kRefineMargin) return w + inSpheres(q);
-    return windingNumber(tree, q, kRefineBeta) + inSpheres(q);
+    // The decision is the exact one except where the exact value itself is within 1e-3 of the threshold.
+    return windingNumberToDecide(tree, q, 0, kWindingThreshold) + inSpheres(q);
   }
   // The fast value alone: enough to round w + s to the integer k (HoleCaps).
   double rough(const Vec3& q) const { return windingNumber(tree, q) + inSpheres(q); }
@@ -294,40 +289,25 @@ Piece decideRun(uint32_t lo, uint32_t hi, const Inside& inside) {
 // box): the mesh with its caps is closed, so its winding number is an integer k, constant in each region that
 // neither the surface nor a cap crosses, and the mesh's own winding number is w = k - s, s the caps' winding number.
 // Empty runs whose boxes meet no cap, joined face to face, share k: one evaluation of w + s finds it for a whole
-// group. Each cap's |s| is at most capArea / (4 pi d^2) at a distance d from its box; where the sum of these bounds
-// stays under kByIntegerAlone (< 0.5), |k - s| >= 0.5 exactly when k != 0, so k alone decides. Nearer the holes the
+// group. Where capWindingBound stays under kCapBoundForInteger (open_edges.h), k alone decides. Nearer the holes the
 // runs are decided by k - s, s from the caps' own small tree; only runs that a cap crosses need w itself.
 struct HoleCaps {
   bool enabled = false;
   std::vector<OpenBoundary> boundaries;
   std::vector<Triangle> triangles;  // every boundary's cap
   WindingTree tree;                 // over `triangles`
-  static constexpr double kByIntegerAlone = 0.45;
-  static constexpr size_t kMaxBoundaries = 64;  // more: a soup, where every run is evaluated
 
   HoleCaps(std::vector<OpenBoundary>&& openBoundaries, bool leaky) {
     // Gaps in a `center` surface join cells on both sides of it: no constant k between them.
     if (leaky) return;
     boundaries = std::move(openBoundaries);
-    enabled = boundaries.size() <= kMaxBoundaries;
+    enabled = boundaries.size() <= kMaxCapBoundaries;
     if (!enabled) return;
     for (const OpenBoundary& b : boundaries) triangles.insert(triangles.end(), b.cap.begin(), b.cap.end());
     tree = buildWindingTree(triangles);
   }
   // Bound on |s| over `run`; infinite when the run meets a boundary's box.
-  double bound(const Box& run) const {
-    double sum = 0;
-    for (const OpenBoundary& b : boundaries) {
-      double d2 = 0;
-      for (int a = 0; a < 3; ++a) {
-        const double gap = std::max({b.bounds.lo[a] - run.hi[a], run.lo[a] - b.bounds.hi[a], 0.0});
-        d2 += gap * gap;
-      }
-      if (d2 == 0) return std::numeric_limits<double>::infinity();
-      sum += b.capArea / (4 * std::numbers::pi * d2);
-    }
-    return sum;
-  }
+  double bound(const Box& run) const { return capWindingBound(boundaries, run); }
   // Whether a cap may meet the closed box `run` (sat never misses a contact).
   bool meets(const Box& run) const {
     for (const OpenBoundary& b : boundaries) {
@@ -386,12 +366,7 @@ struct HoleCaps {
     return true;
   }
   // The caps' winding number at q, close enough to decide |k - s| >= 0.5 as the exact value does.
-  double at(const Vec3& q, int64_t k) const {
-    constexpr double kRefineMargin = 0.05, kRefineBeta = 8;
-    const double s = windingNumber(tree, q);
-    if (std::abs(std::abs(double(k) - s) - kWindingThreshold) >= kRefineMargin) return s;
-    return windingNumber(tree, q, kRefineBeta);
-  }
+  double at(const Vec3& q, int64_t k) const { return windingNumberToDecide(tree, q, double(k), kWindingThreshold); }
   static bool overlaps(const Box& a, const Box& b) {
     for (int i = 0; i < 3; ++i)
       if (a.hi[i] < b.lo[i] || b.hi[i] < a.lo[i]) return false;
@@ -569,9 +544,7 @@ std::pair<uint64_t, uint64_t> decideRuns(const Grid& grid, const FillWinding* wi
         pieces[run.slot] = byWinding(r, run, counts);
         state[run.slot] = kDecided;
       } else {
-        state[run.slot] = caps->bound(box) <= HoleCaps::kByIntegerAlone ? kByInteger
-                          : caps->meets(box)                            ? kCrossed
-                                                                        : kByCaps;
+        state[run.slot] = caps->bound(box) <= kCapBoundForInteger ? kByInteger : caps->meets(box) ? kCrossed : kByCaps;
       }
     }
   });
@@ -612,7 +585,7 @@ FillReport startFill(const Grid& grid, const Scene& scene, const FillOptions& op
     fail<LimitError>("solid fill of ", scene.triangles.size(), " triangles needs about ",
                      uint64_t(treeBytes / (1 << 20)), " MiB of scratch memory, more than the ",
                      options.memoryLimitBytes >> 20, " MiB allowed");
-  std::vector<OpenBoundary> boundaries = openBoundaries(scene.triangles, &report.openEdges, HoleCaps::kMaxBoundaries);
+  std::vector<OpenBoundary> boundaries = openBoundaries(scene.triangles, &report.openEdges, kMaxCapBoundaries);
   CancelCheck{&options, 0}();  // the edge weld and the tree build: 0.03 s each for the bunny
   report.rule = report.openEdges > 0 || report.leakyMethod ? FillRule::WindingNumber : FillRule::Enclosed;
   if (options.rule) report.rule = *options.rule;

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <limits>
+#include <numbers>
 #include <numeric>
 #include <tuple>
 #include <unordered_map>
@@ -106,6 +108,20 @@ std::vector<OpenBoundary> openBoundaries(std::span<const Triangle> triangles, ui
     b.capArea += 0.5 * std::abs(n) * length(cross(from - c, to - c));
   }
   return out;
+}
+
+double capWindingBound(std::span<const OpenBoundary> boundaries, const Box& region) {
+  double sum = 0;
+  for (const OpenBoundary& b : boundaries) {
+    double d2 = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double gap = std::max({b.bounds.lo[a] - region.hi[a], region.lo[a] - b.bounds.hi[a], 0.0});
+      d2 += gap * gap;
+    }
+    if (d2 == 0) return std::numeric_limits<double>::infinity();
+    sum += b.capArea / (4 * std::numbers::pi * d2);
+  }
+  return sum;
 }
 
 }  // namespace vox

@@ -163,4 +163,11 @@ double windingNumber(const WindingTree& tree, const Vec3& q, double beta) {
   return w;
 }
 
+double windingNumberToDecide(const WindingTree& tree, const Vec3& q, double offset, double threshold) {
+  constexpr double kRefineMargin = 0.05, kRefineBeta = 8;
+  const double w = windingNumber(tree, q);
+  if (std::abs(std::abs(offset - w) - threshold) >= kRefineMargin) return w;
+  return windingNumber(tree, q, kRefineBeta);
+}
+
 }  // namespace vox

@@ -38,4 +38,12 @@ struct OpenBoundary {
 std::vector<OpenBoundary> openBoundaries(std::span<const Triangle> triangles, uint64_t* openEdges = nullptr,
                                          size_t capLimit = SIZE_MAX);
 
+// Caps are built for at most this many boundaries: more make a soup, where the caps would not pay.
+inline constexpr size_t kMaxCapBoundaries = 64;
+// A bound on |s|, the caps' winding number, anywhere in `region`: each cap of area A seen from a distance d adds at
+// most A / (4 pi d^2), d from `region` to its boundary's box; infinity when `region` meets one. Where it stays under
+// kCapBoundForInteger (< 0.5), |k - s| >= 0.5 exactly when the integer k != 0, so k alone decides.
+double capWindingBound(std::span<const OpenBoundary> boundaries, const Box& region);
+inline constexpr double kCapBoundForInteger = 0.45;
+
 }  // namespace vox

@@ -155,9 +155,9 @@ double NearestPrimitive::squaredDistanceTo(uint32_t slot, const Vec3& p, double 
 // box alone). Near answers lie in near subtrees, so this tests fewer boxes than a descent from the root.
 NearestHit NearestPrimitive::nearestFrom(const Vec3& p, int64_t seed) const {
   if (seed < 0 || uint64_t(seed) >= ids_.size()) return nearest(p);
-  const uint32_t slot = slotOf_[size_t(seed)];
-  NearestHit best{squaredDistanceTo(slot, p, INFINITY), seed};
-  uint32_t node = leafOf_[slot];
+  // The seed's leaf first, the seed among its primitives: its distance becomes the bound.
+  NearestHit best;
+  uint32_t node = leafOf_[slotOf_[size_t(seed)]];
   visitLeaf(nodes_[node], p, best);
   while (node != 0) {
     const uint32_t parent = nodes_[node].parent;

@@ -117,20 +117,10 @@ void checkPoints(std::span<const double> points) {
     fail<LimitError>("point distances: ", points.size() / 3, " points, more than 2^32 - 1 in one call");
 }
 
-}  // namespace
-
-void pointDistances(const Scene& scene, std::span<const double> points, bool signedDistance,
-                    const PointDistanceOutput& out, const DistanceQueryOptions& options) {
-  checkPoints(points);
-  const NearestPrimitive nearest(scene);
-  std::optional<InsideTest> insideTest;
-  if (signedDistance) insideTest.emplace(scene);
-  pointDistances(nearest, insideTest ? &*insideTest : nullptr, points, out, options);
-}
-
-void pointDistances(const NearestPrimitive& nearest, const InsideTest* insideTest, std::span<const double> points,
-                    const PointDistanceOutput& out, const DistanceQueryOptions& options) {
-  checkPoints(points);
+// pointDistances after checkPoints.
+void checkedPointDistances(const NearestPrimitive& nearest, const InsideTest* insideTest,
+                           std::span<const double> points, const PointDistanceOutput& out,
+                           const DistanceQueryOptions& options) {
   const size_t n = points.size() / 3;
   const std::vector<uint32_t> order = spatialOrder(points);
   QueryProgress progress{options, n};
@@ -152,6 +142,23 @@ void pointDistances(const NearestPrimitive& nearest, const InsideTest* insideTes
     progress.report(r.size());
   });
   if (progress.cancelled) fail<Error>("point distances cancelled");
+}
+
+}  // namespace
+
+void pointDistances(const Scene& scene, std::span<const double> points, bool signedDistance,
+                    const PointDistanceOutput& out, const DistanceQueryOptions& options) {
+  checkPoints(points);  // before the structures are built
+  const NearestPrimitive nearest(scene);
+  std::optional<InsideTest> insideTest;
+  if (signedDistance) insideTest.emplace(scene);
+  checkedPointDistances(nearest, insideTest ? &*insideTest : nullptr, points, out, options);
+}
+
+void pointDistances(const NearestPrimitive& nearest, const InsideTest* insideTest, std::span<const double> points,
+                    const PointDistanceOutput& out, const DistanceQueryOptions& options) {
+  checkPoints(points);
+  checkedPointDistances(nearest, insideTest, points, out, options);
 }
 
 }  // namespace vox

@@ -149,25 +149,29 @@ ColumnTable columnPrims(const Grid& grid, size_t nTri) {
 
 // Which triangles may cross line a + (nx + 1) b: those of the four cell columns around it (a triangle crossing the
 // line at height z meets the closed cells there), and those sticking out of the grid (rare: user bounds cutting the
-// scene, a box test each). Sorted, each once, into `out`.
+// scene, a box test each). Each list goes to `visit` as a span; a triangle may come more than once.
+template <typename Visit>
+void forLineCandidates(const Grid& grid, const Scene& scene, const ColumnTable& columns, uint64_t line,
+                       const Visit& visit) {
+  const uint64_t nx = grid.dims[0], ny = grid.dims[1], a = line % (nx + 1), b = line / (nx + 1);
+  for (uint64_t j = b > 0 ? b - 1 : 0; j <= b && j < ny; ++j)
+    for (uint64_t i = a > 0 ? a - 1 : 0; i <= a && i < nx; ++i) visit(columns.of(i + nx * j));
+  if (grid.outsidePrims.empty()) return;
+  const double X = cellBoundary(grid.bounds, grid.dims, 0, int64_t(a));
+  const double Y = cellBoundary(grid.bounds, grid.dims, 1, int64_t(b));
+  for (const uint32_t& p : grid.outsidePrims) {
+    if (p >= scene.triangles.size()) continue;
+    const Box box = triangleBounds(scene.triangles[p]);
+    if (X >= box.lo.x && X <= box.hi.x && Y >= box.lo.y && Y <= box.hi.y) visit(std::span<const uint32_t>(&p, 1));
+  }
+}
+
+// The candidates of forLineCandidates, sorted, each once, into `out`.
 void linePrims(const Grid& grid, const Scene& scene, const ColumnTable& columns, uint64_t line,
                std::vector<uint32_t>& out) {
-  const uint64_t nx = grid.dims[0], ny = grid.dims[1], a = line % (nx + 1), b = line / (nx + 1);
   out.clear();
-  for (uint64_t j = b > 0 ? b - 1 : 0; j <= b && j < ny; ++j)
-    for (uint64_t i = a > 0 ? a - 1 : 0; i <= a && i < nx; ++i) {
-      const std::span<const uint32_t> prims = columns.of(i + nx * j);
-      out.insert(out.end(), prims.begin(), prims.end());
-    }
-  if (!grid.outsidePrims.empty()) {
-    const double X = cellBoundary(grid.bounds, grid.dims, 0, int64_t(a));
-    const double Y = cellBoundary(grid.bounds, grid.dims, 1, int64_t(b));
-    for (const uint32_t p : grid.outsidePrims) {
-      if (p >= scene.triangles.size()) continue;
-      const Box box = triangleBounds(scene.triangles[p]);
-      if (X >= box.lo.x && X <= box.hi.x && Y >= box.lo.y && Y <= box.hi.y) out.push_back(p);
-    }
-  }
+  forLineCandidates(grid, scene, columns, line,
+                    [&](std::span<const uint32_t> prims) { out.insert(out.end(), prims.begin(), prims.end()); });
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
 }
@@ -188,17 +192,15 @@ LineTable buildLines(const Grid& grid, const Scene& scene, const FractionOptions
     fail<LimitError>("volume fractions: the cell lines' crossings need ", uint64_t(bytes) >> 20, " MiB, more than the ",
                      options.memoryLimitBytes >> 20, " MiB allowed");
   const ColumnTable columns = columnPrims(grid, scene.triangles.size());
-  // Each line's slots: as many as triangles may cross it (compacted to the crossings below).
+  // Each line's slots: its candidates counted with repeats, a bound on its crossings (compacted to them below).
   table.keys = std::move(needed);
   table.start.assign(table.keys.size() + 1, 0);
-  tbb::enumerable_thread_specific<std::vector<uint32_t>> scratch;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, table.keys.size(), 256), [&](const auto& r) {
-    std::vector<uint32_t>& prims = scratch.local();
-    for (size_t g = r.begin(); g < r.end(); ++g) {
-      linePrims(grid, scene, columns, table.keys[g], prims);
-      table.start[g + 1] = prims.size();
-    }
+    for (size_t g = r.begin(); g < r.end(); ++g)
+      forLineCandidates(grid, scene, columns, table.keys[g],
+                        [&](std::span<const uint32_t> prims) { table.start[g + 1] += prims.size(); });
   });
+  tbb::enumerable_thread_specific<std::vector<uint32_t>> scratch;
   for (size_t g = 0; g < table.keys.size(); ++g) table.start[g + 1] += table.start[g];
   table.crossings.resize(table.start.back());
   std::vector<size_t> counts(table.keys.size());

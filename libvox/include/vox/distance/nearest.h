@@ -26,8 +26,8 @@ class NearestPrimitive {
   explicit NearestPrimitive(const Scene& scene);
 
   // The primitive nearest to p, ties to the lowest id. `bound2`: a squared distance the caller knows the answer does
-  // not exceed (a neighbour's distance plus their separation, rounded up), which prunes the search; subtrees and
-  // primitives farther than it are skipped, so a bound below the true distance gives primitive -1.
+  // not exceed, which prunes the search; subtrees and primitives farther than it are skipped, so a bound below the
+  // true distance gives primitive -1.
   NearestHit nearest(const Vec3& p, double bound2 = INFINITY) const;
   // The same answer, searched from primitive `seed` (a neighbour's nearest, or -1 for none): its distance is the
   // first bound, which is tight when the seed is the answer or nearly so, so the search visits few nodes.

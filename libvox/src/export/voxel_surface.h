@@ -17,6 +17,7 @@
 #include "vox/core/error.h"
 #include "vox/core/grid.h"
 #include "vox/core/math.h"
+#include "vox/core/resize_in_steps.h"
 #include "vox/export/voxel_mesh.h"
 
 namespace vox::voxel_surface {
@@ -68,13 +69,7 @@ class ExportProgress {
   // which took 0.4 to 3.4 s for the largest arrays of the bunny at 512^3 on a busy machine. Values as resize gives.
   template <typename T>
   void resize(std::vector<T>& v, size_t n) {
-    const size_t step = std::max<size_t>(1, (size_t{8} << 20) / sizeof(T));
-    v.reserve(n);
-    while (v.size() < n) {
-      v.resize(std::min(n, v.size() + step));
-      ask(from_);
-    }
-    v.resize(n);  // n below the size
+    resizeInSteps(v, n, T{}, [&] { ask(from_); });
   }
   bool cancelled() const { return cancelled_.load(std::memory_order_relaxed); }
   void check() const {

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "vox/core/error.h"
+#include "vox/core/resize_in_steps.h"
 
 namespace vox {
 
@@ -37,14 +38,10 @@ class ImportProgress {
   // thread alone, 0.18 s for the arrays of a 286 MB OBJ. Values as resize gives.
   template <typename Vector>
   void resize(Vector& v, size_t n, double fraction) {
-    const size_t step = std::max<size_t>(1, (size_t{8} << 20) / sizeof(v[0]));
-    v.reserve(n);
-    while (v.size() < n) {
-      v.resize(std::min(n, v.size() + step));
+    resizeInSteps(v, n, typename Vector::value_type{}, [&] {
       report(fraction);
       check();
-    }
-    v.resize(n);  // n below the size
+    });
   }
   bool cancelled() const { return cancelled_.load(std::memory_order_relaxed); }
   void check() const {

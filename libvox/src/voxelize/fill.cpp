@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "vox/core/error.h"
+#include "vox/core/resize_in_steps.h"
 #include "vox/voxelize/open_edges.h"
 #include "vox/voxelize/overlap.h"
 #include "vox/voxelize/winding_number.h"
@@ -76,12 +77,7 @@ struct CancelCheck {
 template <typename T>
 std::vector<T> slotVector(size_t n, const T& value, const CancelCheck& check) {
   std::vector<T> v;
-  v.reserve(n);
-  const size_t step = std::max<size_t>(1, (size_t{8} << 20) / sizeof(T));
-  while (v.size() < n) {
-    v.resize(std::min(n, v.size() + step), value);
-    check();
-  }
+  resizeInSteps(v, n, value, [&] { check(); });
   return v;
 }
 

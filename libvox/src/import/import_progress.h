@@ -4,7 +4,6 @@
 // the calling thread makes it: a few hundred MB of OBJ take seconds to read.
 #pragma once
 
-#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <functional>

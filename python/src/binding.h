@@ -35,6 +35,22 @@ namespace py = pybind11;
 
 // A grid with the scene it was voxelized from (read-only once made). The trace-time structure is built on first use
 // (intersect, occluded, render) and kept.
+// A structure built on first use from any thread and kept (std::call_once): what a grid's ray and distance calls
+// query again and again. A build that throws leaves it unbuilt, to be tried again.
+template <typename T>
+class BuiltOnce {
+ public:
+  template <typename Make>
+  const T& get(const Make& make) {
+    std::call_once(once_, [&] { value_ = std::make_unique<T>(make()); });
+    return *value_;
+  }
+
+ private:
+  std::once_flag once_;
+  std::unique_ptr<T> value_;
+};
+
 class PyGrid {
  public:
   // `source`: the file system bytes of the path it came from, or "<arrays>".
@@ -54,11 +70,9 @@ class PyGrid {
  private:
   std::shared_ptr<const vox::GridFile> file_;
   std::string source_;
-  std::once_flag accelOnce_;
-  std::unique_ptr<vox::Accel> accel_;
-  std::once_flag nearestOnce_, insideOnce_;
-  std::unique_ptr<vox::NearestPrimitive> nearest_;
-  std::unique_ptr<vox::InsideTest> insideTest_;
+  BuiltOnce<vox::Accel> accel_;
+  BuiltOnce<vox::NearestPrimitive> nearest_;
+  BuiltOnce<vox::InsideTest> insideTest_;
 };
 
 // ---- Long calls (call.cpp) ----

@@ -14,20 +14,15 @@ PyGrid::PyGrid(vox::GridFile file, std::string source)
     : file_(std::make_shared<const vox::GridFile>(std::move(file))), source_(std::move(source)) {}
 
 const vox::Accel& PyGrid::accel() {
-  std::call_once(accelOnce_, [&] {
-    accel_ = std::make_unique<vox::Accel>(vox::buildAccel(file_->scene, file_->grid, vox::AccelKind::Grid));
-  });
-  return *accel_;
+  return accel_.get([&] { return vox::buildAccel(file_->scene, file_->grid, vox::AccelKind::Grid); });
 }
 
 const vox::NearestPrimitive& PyGrid::nearest() {
-  std::call_once(nearestOnce_, [&] { nearest_ = std::make_unique<vox::NearestPrimitive>(file_->scene); });
-  return *nearest_;
+  return nearest_.get([&] { return vox::NearestPrimitive(file_->scene); });
 }
 
 const vox::InsideTest& PyGrid::insideTest() {
-  std::call_once(insideOnce_, [&] { insideTest_ = std::make_unique<vox::InsideTest>(file_->scene); });
-  return *insideTest_;
+  return insideTest_.get([&] { return vox::InsideTest(file_->scene); });
 }
 
 namespace {

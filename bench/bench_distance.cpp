@@ -7,13 +7,12 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "bench_options.h"
 #include "vox/distance/nearest.h"
 #include "vox/distance/queries.h"
 #include "vox/distance/sdf.h"
@@ -23,9 +22,8 @@
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double seconds(Clock::time_point since) { return std::chrono::duration<double>(Clock::now() - since).count(); }
+using vox::bench::Clock;
+using vox::bench::seconds;
 
 template <typename F>
 double best(int runs, const F& run) {
@@ -41,23 +39,17 @@ double best(int runs, const F& run) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int runs = 3, threads = 2;
   size_t pointCount = 1000000;
-  std::vector<uint32_t> resolutions;
-  std::string path = std::string(VOX_SEED_DIR) + "/meshes/bun_zipper.ply";
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--runs" && i + 1 < argc)
-      runs = std::atoi(argv[++i]);
-    else if (a == "--threads" && i + 1 < argc)
-      threads = std::atoi(argv[++i]);
-    else if (a == "--points" && i + 1 < argc)
-      pointCount = size_t(std::atoll(argv[++i]));
-    else if (a == "--res" && i + 1 < argc)
-      resolutions.push_back(uint32_t(std::atoi(argv[++i])));
-    else
-      path = a;
-  }
+  const vox::bench::BenchOptions options =
+      vox::bench::parseBenchOptions(argc, argv, {3, 2, {}, std::string(VOX_SEED_DIR) + "/meshes/bun_zipper.ply"},
+                                    [&](const std::string& flag, const char* value) {
+                                      if (flag != "--points") return false;
+                                      pointCount = size_t(std::atoll(value));
+                                      return true;
+                                    });
+  const int runs = options.runs, threads = options.threads;
+  const std::string& path = options.mesh;
+  std::vector<uint32_t> resolutions = options.resolutions;
   if (resolutions.empty()) resolutions = {64, 128};
   const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
   tbb::parallel_for(0, threads, [](int) {});  // the worker threads started before any clock

@@ -9,12 +9,11 @@
 #include <CGAL/Gmpq.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <string>
 #include <vector>
 
+#include "bench_options.h"
 #include "vox/core/compensated_sum.h"
 #include "vox/import/import.h"
 #include "vox/volume/fractions.h"
@@ -23,9 +22,8 @@
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double seconds(Clock::time_point since) { return std::chrono::duration<double>(Clock::now() - since).count(); }
+using vox::bench::Clock;
+using vox::bench::seconds;
 
 double cellVolume(const vox::Grid& g, uint64_t key) {
   const auto ijk = vox::cellIndex(g.dims, key);
@@ -47,20 +45,12 @@ double exactSignedVolume(const vox::Scene& s) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int runs = 5, threads = 2;
-  std::vector<uint32_t> resolutions;
-  std::string path = std::string(VOX_SEED_DIR) + "/6837/scenes/bunny_5k.obj";
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--runs" && i + 1 < argc)
-      runs = std::atoi(argv[++i]);
-    else if (a == "--threads" && i + 1 < argc)
-      threads = std::atoi(argv[++i]);
-    else if (a == "--res" && i + 1 < argc)
-      resolutions.push_back(uint32_t(std::atoi(argv[++i])));
-    else
-      path = a;
-  }
+  const vox::bench::BenchOptions options =
+      vox::bench::parseBenchOptions(argc, argv, {5, 2, {}, std::string(VOX_SEED_DIR) + "/6837/scenes/bunny_5k.obj"},
+                                    [](const std::string&, const char*) { return false; });
+  const int runs = options.runs, threads = options.threads;
+  const std::string& path = options.mesh;
+  std::vector<uint32_t> resolutions = options.resolutions;
   if (resolutions.empty()) resolutions = {64, 128, 256};
   const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
   tbb::parallel_for(0, threads, [](int) {});  // the worker threads started before any clock

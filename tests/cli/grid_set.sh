@@ -8,26 +8,8 @@ SRC=$2
 SEED=${VOX_SEED_DIR:-$SRC/data}
 T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
-fails=0
-passes=0
-check() {  # check NAME EXPECTED_CODE COMMAND...
-  local name=$1 expected=$2
-  shift 2
-  "$@" >"$T/out" 2>"$T/err"
-  local code=$?
-  if [ "$code" != "$expected" ]; then
-    echo "FAIL $name: exit $code, expected $expected"; cat "$T/err"; fails=$((fails + 1))
-  else
-    passes=$((passes + 1))
-  fi
-}
-expect_err() {  # expect_err NAME PATTERN: stderr has exactly one line and it matches
-  if [ "$(wc -l <"$T/err")" != 1 ] || ! grep -q -- "$2" "$T/err"; then
-    echo "FAIL $1: stderr should be one line matching '$2':"; cat "$T/err"; fails=$((fails + 1))
-  else
-    passes=$((passes + 1))
-  fi
-}
+# shellcheck source=lib/check.sh
+source "$(dirname "$0")/lib/check.sh"
 same() {  # same NAME FILE1 FILE2
   if cmp -s "$2" "$3"; then passes=$((passes + 1)); else echo "FAIL $1: $2 and $3 differ"; fails=$((fails + 1)); fi
 }

@@ -30,19 +30,9 @@ if grep -q "VOX_SANITIZE:BOOL=ON" "$BIN/CMakeCache.txt" 2>/dev/null; then
   SOME_K="3"
   BATCH_K="2"
 fi
-fails=0
-passes=0
-check() {  # check NAME EXPECTED_CODE COMMAND...
-  local name=$1 expected=$2
-  shift 2
-  timeout 300 "$@" >"$T/out" 2>"$T/err"
-  local code=$?
-  if [ "$code" != "$expected" ]; then
-    echo "FAIL $name: exit $code, expected $expected"; cat "$T/err"; fails=$((fails + 1))
-  else
-    passes=$((passes + 1))
-  fi
-}
+CHECK_TIMEOUT=300
+# shellcheck source=lib/check.sh
+source "$(dirname "$0")/lib/check.sh"
 same() {  # same NAME FILE1 FILE2
   if cmp -s "$2" "$3"; then passes=$((passes + 1)); else echo "FAIL $1: $2 and $3 differ"; fails=$((fails + 1)); fi
 }

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages libvox needs, idempotently: nothing is fetched when all are present.
-# Usage: scripts/install-deps.sh [--bench] [--meshlab] [--clients] [--fuzz] [--format]
+# Usage: scripts/install-deps.sh [--bench] [--meshlab] [--clients] [--fuzz] [--format] [--list]
+# --list prints the packages the other options name, one a line, and installs nothing (scripts/check-commands.py).
 set -euo pipefail
 packages=(build-essential cmake ninja-build pkg-config python3
   libcgal-dev libopenmesh-dev libopenimageio-dev libtinygltf-dev libstb-dev nlohmann-json3-dev
@@ -12,13 +13,19 @@ packages=(build-essential cmake ninja-build pkg-config python3
   # Packaging (issue 36): cpack's Debian package (dpkg-shlibdeps), man pages from --help; Dask for the Python test that
   # voxelizes over a LocalCluster; ccache, used by the build when present.
   dpkg-dev help2man python3-dask python3-distributed ccache
+  # cpack's Debian generator runs `file` (CPackDeb.cmake) besides dpkg-shlibdeps: missing on a minbase Debian (issue 45).
+  file
+  # Property-based tests (issue 45): Hypothesis for the Python package, RapidCheck for the library.
+  python3-hypothesis librapidcheck-dev
   # The viewer page (vox-export -o OUT.html, viewer/): its script is bundled at build time with Node.js and npm.
   nodejs)
 # npm: Debian's package, unless an npm is already there (NodeSource's nodejs brings its own, and Debian's npm would
 # pull Debian's older nodejs over it).
 command -v npm >/dev/null || packages+=(npm)
+list=0
 for arg in "$@"; do
   case $arg in
+    --list) list=1 ;;
     # bench/python_bench.py compares with Open3D (Debian's 0.16) and draws its bars with tqdm.
     --bench) packages+=(libbenchmark-dev libembree-dev python3-open3d python3-tqdm python3-matplotlib) ;;
     --meshlab) packages+=(meshlab xvfb xauth) ;;
@@ -31,6 +38,10 @@ for arg in "$@"; do
     *) echo "install-deps.sh: unknown option $arg" >&2; exit 1 ;;
   esac
 done
+if [ $list = 1 ]; then
+  printf '%s\n' "${packages[@]}"
+  exit 0
+fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

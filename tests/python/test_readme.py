@@ -34,7 +34,8 @@ def test_readme_example(tmp_path, monkeypatch):
     assert blocks
     scope = run_block(blocks[0], tmp_path, monkeypatch)
     assert scope["grid"].dims == (128, 127, 99)
-    assert (tmp_path / "bunny.binvox").stat().st_size > 0 and (tmp_path / "bunny.png").stat().st_size > 0
+    assert (tmp_path / "out" / "bunny.binvox").stat().st_size > 0 and (tmp_path / "out" / "bunny.png").stat().st_size > 0
+    assert not (tmp_path / "bunny.binvox").exists()  # nothing outside out/, which .gitignore covers
     assert list(scope["prim"] >= 0) == [True, True, False]
     assert scope["image"].shape == (400, 400, 3)
 

@@ -176,14 +176,16 @@ TEST(SignInvariants, CutBoundsAndEveryMethodSignLikeThePointQuery) {
   o.dims = {8, 8, 8};
   o.bounds = Box{{0.25, 0.25, 0.25}, {0.75, 0.75, 0.75}};
   const Grid g = voxelizeScene(cube, o);
-  const SdfBand band = signedDistanceBand(g, cube);
+  SdfOptions wide;
+  wide.halfWidth = 8;  // every cell: the nearest face lies 0.25 to 0.47 away, cells are 0.0625
+  const SdfBand band = signedDistanceBand(g, cube, wide);
   ASSERT_EQ(band.keys.size(), 512u);
   for (const double v : band.values) EXPECT_LT(v, 0);
-  expectSignsAgree(cube, o, 3, "cube inside the bounds");
+  expectSignsAgree(cube, o, 8, "cube inside the bounds");
   o.bounds = Box{{0.5, 0.5, 0.5}, {1.5, 1.5, 1.5}};
   expectSignsAgree(cube, o, 3, "cube cut at a corner");
   const Scene ball = testing::sphereMesh({0.5, 0.5, 0.5}, 0.4, 3);
-  for (const OverlapMethod m : {OverlapMethod::Center, OverlapMethod::Exact, OverlapMethod::Sat, OverlapMethod::Bbox}) {
+  for (const OverlapMethod m : {OverlapMethod::Center, OverlapMethod::Exact, OverlapMethod::Sat, OverlapMethod::BBox}) {
     VoxelizeOptions b;
     b.resolution = 24;
     b.method = m;
@@ -240,7 +242,7 @@ TEST(SignInvariants, RandomMeshesBoundsMethodsAndResolutions) {
     }
     VoxelizeOptions o;
     o.method =
-        std::array{OverlapMethod::Exact, OverlapMethod::Sat, OverlapMethod::Bbox, OverlapMethod::Center}[rng() % 4];
+        std::array{OverlapMethod::Exact, OverlapMethod::Sat, OverlapMethod::BBox, OverlapMethod::Center}[rng() % 4];
     o.dims = std::array<uint32_t, 3>{1 + uint32_t(rng() % 32), 1 + uint32_t(rng() % 32), 1 + uint32_t(rng() % 32)};
     const int boundsKind = int(rng() % 4);  // the scene's own, inside, cutting, outside
     if (boundsKind > 0) {

@@ -322,7 +322,13 @@ TEST(Fill, SuspiciousResultsAreNamedAndBudgetIsChecked) {
   opt.dims = {4, 4, 4};
   Grid inside = voxelizeScene(scene, opt);
   FillReport r = fillSolid(inside, scene);
-  EXPECT_EQ(r.solidCells, 0u);  // an empty row is a single run from face to face: outside
+  EXPECT_EQ(r.solidCells, 64u);  // the surfaces outside the bounds count (issue 45)
+  EXPECT_EQ(fillWarning(r), "");
+  // Bounds beside the box: nothing inside.
+  opt.bounds = Box{{1.5, 0.4, 0.4}, {2, 0.6, 0.6}};
+  Grid beside = voxelizeScene(scene, opt);
+  r = fillSolid(beside, scene);
+  EXPECT_EQ(r.solidCells, 0u);
   EXPECT_NE(fillWarning(r).find("nothing filled"), std::string::npos);
   // A closed surface on the grid's faces: nothing is outside.
   opt.bounds = Box{{0, 0, 0}, {1, 1, 1}};

@@ -58,6 +58,7 @@ InsideTest::InsideTest(const Scene& scene) {
   triangles_.assign(scene.triangles.begin(), scene.triangles.end());
   meshCount_ = triangles_.size();
   for (const OpenBoundary& b : boundaries_) triangles_.insert(triangles_.end(), b.cap.begin(), b.cap.end());
+  capTree_ = buildWindingTree({triangles_.data() + meshCount_, triangles_.size() - meshCount_});
   if (triangles_.size() > UINT32_MAX) fail<LimitError>("inside test: more than 2^32 - 1 triangles with the caps");
   // Triangles edge-on to x are never crossed: left out of the tree.
   for (uint32_t t = 0; t < triangles_.size(); ++t) {
@@ -151,6 +152,11 @@ bool InsideTest::inside(const Vec3& p, const std::vector<Crossing>& crossings) c
   const std::span<const Triangle> mesh(triangles_.data(), meshCount_);
   if (onCap) return std::fabs(windingNumberExact(mesh, p)) >= kWindingThreshold;
   if (capWindingBound(boundaries_, Box{p, p}) < kCapBoundForInteger) return k != 0;
+  // The caps' tree first (beta 2: errors of about 1e-3, and 0.03 seen at worst on grazing views); the exact sum
+  // over the caps' triangles only where |k - s| lies within kExactMargin of the threshold.
+  constexpr double kExactMargin = 0.25;
+  const double rough = std::fabs(double(k) - windingNumber(capTree_, p));
+  if (std::fabs(rough - kWindingThreshold) > kExactMargin) return rough >= kWindingThreshold;
   const double s = windingNumberExact({triangles_.data() + meshCount_, triangles_.size() - meshCount_}, p);
   return std::fabs(double(k) - s) >= kWindingThreshold;
 }

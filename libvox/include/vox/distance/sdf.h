@@ -42,9 +42,10 @@ struct SdfBand {
 // s the caps'. k at p is the signed count of the crossings of p's row line (along x) before p, each decided exactly
 // (orient2d against the triangle's edges with the line perturbed symbolically, so an edge or a vertex on the line
 // counts once; orient3d against its plane); the triangles whose (y, z) box holds the line come from a tree. Far
-// from every hole (capWindingBound < kCapBoundForInteger) k alone decides; nearer, s is summed over the caps'
-// triangles (exact to rounding: the decision is w's wherever |w| is not within about 1e-12 of the threshold); a
-// point on a cap takes w summed over every triangle. A closed, consistently oriented mesh has no caps: exact. More
+// from every hole (capWindingBound < kCapBoundForInteger) k alone decides; nearer, s comes from the caps' tree, and
+// where |k - s| is within 0.25 of the threshold it is summed over the caps' triangles (exact to rounding there: the
+// decision is w's unless |w| is within about 1e-12 of the threshold or the tree errs by 0.25); a point on a cap
+// takes w summed over every triangle. A closed, consistently oriented mesh has no caps: exact. More
 // than kMaxCapBoundaries holes (a soup) fall back to the winding tree (windingNumberToDecide, about 1e-3 off).
 class InsideTest {
  public:
@@ -75,7 +76,8 @@ class InsideTest {
   bool counted_ = false;  // caps built (at most kMaxCapBoundaries holes): k - s; otherwise the tree
   std::vector<LineNode> lineNodes_;
   std::vector<uint32_t> order_;
-  WindingTree tree_;
+  WindingTree tree_;     // a soup's
+  WindingTree capTree_;  // the caps'
   std::vector<EllipsoidShape> shapes_;
 };
 

@@ -3,12 +3,16 @@
 
 #include <unistd.h>
 
+#include <array>
 #include <atomic>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <random>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "vox/core/scene.h"
 
@@ -92,6 +96,57 @@ inline Scene randomScene(uint32_t seed, int triangles, int spheres, double lo = 
     scene.spheres.push_back(s);
   }
   return scene;
+}
+
+// The example count of a seeded property loop: `ci` in the test command, VOX_PROPERTY_RUNS for a longer run by hand.
+inline int propertyRuns(int ci) {
+  const char* env = std::getenv("VOX_PROPERTY_RUNS");
+  return env && std::atoi(env) > 0 ? std::atoi(env) : ci;
+}
+
+// A tetrahedron of four outward-oriented triangles (a, b, c, d in any order; a flat one has no inside).
+inline Scene tetrahedronScene(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  Scene s;
+  s.materials.push_back({});
+  const Vec3 p[4] = {a, b, c, d};
+  const int faces[4][4] = {{0, 1, 2, 3}, {0, 3, 1, 2}, {1, 3, 2, 0}, {0, 2, 3, 1}};
+  for (const auto& f : faces) {
+    Triangle t{{p[f[0]], p[f[1]], p[f[2]]}};
+    if (dot(cross(t.v[1] - t.v[0], t.v[2] - t.v[0]), p[f[3]] - t.v[0]) > 0) std::swap(t.v[1], t.v[2]);
+    s.triangles.push_back(t);
+  }
+  return s;
+}
+
+// A sphere of radius r about c as a closed mesh: an octahedron subdivided `levels` times, its vertices pushed onto
+// the sphere; outward triangles. `bowl`: only the triangles below the plane z = c.z + cut r (an open bowl).
+inline Scene sphereMesh(const Vec3& c, double r, int levels, bool bowl = false, double cut = 0) {
+  std::vector<std::array<Vec3, 3>> tris;
+  for (int sx = -1; sx <= 1; sx += 2)
+    for (int sy = -1; sy <= 1; sy += 2)
+      for (int sz = -1; sz <= 1; sz += 2) {
+        std::array<Vec3, 3> t{Vec3{double(sx), 0, 0}, Vec3{0, double(sy), 0}, Vec3{0, 0, double(sz)}};
+        if (sx * sy * sz < 0) std::swap(t[1], t[2]);
+        tris.push_back(t);
+      }
+  for (int l = 0; l < levels; ++l) {
+    std::vector<std::array<Vec3, 3>> next;
+    for (const auto& t : tris) {
+      const Vec3 m[3] = {normalize(t[0] + t[1]), normalize(t[1] + t[2]), normalize(t[2] + t[0])};
+      next.push_back({t[0], m[0], m[2]});
+      next.push_back({m[0], t[1], m[1]});
+      next.push_back({m[2], m[1], t[2]});
+      next.push_back({m[0], m[1], m[2]});
+    }
+    tris = std::move(next);
+  }
+  Scene s;
+  s.materials.push_back({});
+  for (const auto& t : tris) {
+    if (bowl && (t[0].z + t[1].z + t[2].z) / 3 > cut) continue;
+    s.triangles.push_back({{c + t[0] * r, c + t[1] * r, c + t[2] * r}});
+  }
+  return s;
 }
 
 }  // namespace vox::testing

@@ -45,8 +45,13 @@ if [ -f "$bunny" ]; then
   [ "$(solid)" -gt 0 ] || fail "scanned bunny: no solid cell"
 fi
 
-# Bounds inside the cube: no surface cell, nothing can be decided inside: said, not silent.
+# Bounds inside the cube: no surface cell, but the surfaces outside the bounds count (issue 45): every cell solid.
 fill_line "$src/tests/data/unit_cube.obj" --bounds 0.4 0.4 0.4 0.6 0.6 0.6 --grid 4 4 4
+grep -q '^vox-voxelize: fill: |winding number| >= 0.5 (the bounds cut the scene), 64 solid cells' "$tmp/err" ||
+  fail "bounds inside: $(cat "$tmp/err")"
+[ "$(solid)" = 64 ] || fail "bounds inside: vox-info solid_cells $(solid)"
+# Bounds beside the cube: nothing inside, said, not silent.
+fill_line "$src/tests/data/unit_cube.obj" --bounds 1.4 0.4 0.4 1.6 0.6 0.6 --grid 4 4 4
 grep -q 'warning: .*unit_cube.obj: fill: no empty cell is inside a surface: nothing filled' "$tmp/err" ||
   fail "nothing filled: $(cat "$tmp/err")"
 

@@ -81,3 +81,15 @@ def test_refusals_are_usage_errors():
         libvox.voxelize((v, f), resolution=4, method="center", fraction=True)
     with pytest.raises(TypeError, match="fraction"):
         libvox.voxelize((v, f), resolution=4, fraction="yes")
+
+
+@pytest.mark.parametrize("bounds, want", [
+    (((0.25,) * 3, (0.75,) * 3), 0.125),              # issue 45 #6: inside the cube, no surface cell
+    (((0.5,) * 3, (1.5,) * 3), 0.125),                # a corner
+    (((0.5, 0.25, 0.5), (1.5, 1.0, 1.0)), 0.1875),    # two faces on the bounds' own
+    (((2.0,) * 3, (3.0,) * 3), 0.0)])                 # outside
+def test_bounds_cutting_the_mesh_add_up_to_the_volume_inside(bounds, want):
+    g = libvox.voxelize(box((0, 0, 0), (1, 1, 1)), dims=8, bounds=bounds, fraction=True)
+    fr = np.asarray(g.fractions)
+    assert np.all((fr >= 0) & (fr <= 1))
+    assert total_volume(g) == pytest.approx(want, abs=1e-15)

@@ -98,3 +98,35 @@ def test_dense_sdf_refuses_bad_grids():
         libvox.sdf(CUBE, resolution=0)
     with pytest.raises(libvox.UsageError, match="at most one"):
         libvox.sdf(CUBE, resolution=4, dims=4)
+
+
+def centres_of(g):
+    """Every cell centre in C order, as libvox computes a centre (the midpoint of the cell's two boundaries)."""
+    lo, hi = np.array(g.bounds[0]), np.array(g.bounds[1])
+    ijk = np.indices(tuple(g.dims)).reshape(3, -1).T
+    return 0.5 * (lo + (hi - lo) * ijk / np.array(g.dims) + lo + (hi - lo) * (ijk + 1) / np.array(g.dims))
+
+
+@pytest.mark.parametrize("bounds, inside", [(((0.25,) * 3, (0.75,) * 3), 512), (((0.5,) * 3, (1.5,) * 3), 64)])
+def test_bounds_cutting_the_cube_sign_like_grid_distance(bounds, inside):
+    """Issue 45 #6: the surfaces outside the bounds count; the band, libvox.sdf and Grid.distance agree bit for bit."""
+    field = libvox.sdf(CUBE, dims=8, bounds=bounds)
+    g = libvox.voxelize(CUBE, dims=8, bounds=bounds, sdf=3)
+    indices, values = g.sdf
+    assert np.array_equal(field[tuple(indices.T)], values)
+    d = g.distance(centres_of(g))[0]
+    assert np.array_equal(d, field.reshape(-1))
+    assert np.count_nonzero(field < 0) == inside
+
+
+def test_center_method_signs_like_grid_distance():
+    """Issue 45 #7: method="center" leaves the fill's status wrong; the band's signs must not come from it."""
+    g = libvox.voxelize(CUBE, resolution=12, method="center", sdf=3)
+    indices, values = g.sdf
+    field = libvox.sdf(CUBE, resolution=12)
+    assert np.array_equal(field[tuple(indices.T)], values)
+    d = g.distance(centres_of(g))[0]
+    assert np.array_equal(d, field.reshape(-1))
+    c = centres_of(g)[np.ravel_multi_index(tuple(indices.T), tuple(g.dims))]
+    inside = np.all((c > 0) & (c < 1), axis=1)
+    assert np.array_equal(values < 0, inside)

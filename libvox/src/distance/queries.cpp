@@ -41,7 +41,30 @@ void denseSignedDistances(const Grid& grid, const Scene& scene, std::span<double
   const NearestPrimitive nearest(scene);
   std::function<bool(double)> signProgress;
   if (options.progress) signProgress = [&](double f) { return options.progress(0.1 * f); };
-  const std::vector<uint8_t> centreInside = occupiedCentresInside(grid, scene, signProgress);
+  // Signs first, a row along x at a time (its crossings found once), in key order: one byte per cell beside the
+  // field's eight.
+  std::vector<uint8_t> inside;
+  {
+    const InsideTest test(scene);
+    const uint64_t rowCount = uint64_t(grid.dims[1]) * grid.dims[2];
+    inside.assign(grid.cellCount(), 0);
+    std::atomic<uint64_t> done{0};
+    std::atomic<bool> cancelled{false};
+    const std::array<std::vector<double>, 3> c = cellCentresByAxis(grid);
+    tbb::parallel_for(tbb::blocked_range<uint64_t>(0, rowCount, 16), [&](const tbb::blocked_range<uint64_t>& r) {
+      if (cancelled) return;
+      std::vector<InsideTest::Crossing> crossings;
+      for (uint64_t row = r.begin(); row < r.end(); ++row) {
+        const double qy = c[1][row % grid.dims[1]], qz = c[2][row / grid.dims[1]];
+        test.rowCrossings(qy, qz, crossings);
+        for (uint32_t i = 0; i < grid.dims[0]; ++i)
+          inside[row * grid.dims[0] + i] = test.inside({c[0][i], qy, qz}, crossings);
+      }
+      const uint64_t finished = done += r.size();
+      if (signProgress && !signProgress(double(finished) / double(std::max<uint64_t>(rowCount, 1)))) cancelled = true;
+    });
+    if (cancelled) fail<Error>("signed distances cancelled");
+  }
   const std::array<std::vector<double>, 3> centres = cellCentresByAxis(grid);
   // Rows run along the axis of the smallest stride, so each row's writes are adjacent and each cell's search starts
   // from its neighbour's nearest primitive.
@@ -62,10 +85,8 @@ void denseSignedDistances(const Grid& grid, const Scene& scene, std::span<double
         const NearestHit hit = nearest.nearestFrom(c, previous);
         previous = hit.primitive;
         const double d = std::sqrt(hit.squaredDistance);
-        const uint64_t key = cellKey(grid.dims, ijk[0], ijk[1], ijk[2]);
-        const int64_t cell = findCell(grid, key);
-        const bool inside = cell >= 0 ? d > 0 && centreInside[size_t(cell)] : isSolid(grid, key);
-        out[ijk[0] * strides[0] + ijk[1] * strides[1] + ijk[2] * strides[2]] = inside ? -d : d;
+        const bool in = d > 0 && inside[cellKey(grid.dims, ijk[0], ijk[1], ijk[2])];  // on the surface: +0
+        out[ijk[0] * strides[0] + ijk[1] * strides[1] + ijk[2] * strides[2]] = in ? -d : d;
       }
     }
     progress.report(r.size());

@@ -14,17 +14,6 @@
 
 namespace vox {
 
-InsideTest::InsideTest(const Scene& scene) : tree_(buildWindingTree({scene.triangles.data(), scene.triangles.size()})) {
-  shapes_.reserve(scene.spheres.size());
-  for (const Sphere& s : scene.spheres) shapes_.push_back(ellipsoidShape(s));
-}
-
-bool InsideTest::inside(const Vec3& p) const {
-  for (const EllipsoidShape& s : shapes_)
-    if (insideEllipsoid(s, p)) return true;
-  return !tree_.nodes.empty() && std::fabs(windingNumber(tree_, p)) >= kWindingThreshold;
-}
-
 void checkSdfHalfWidth(double halfWidth, const char* what) {
   if (!(halfWidth > 0) || !(halfWidth <= kMaxSdfHalfWidth))
     fail<UsageError>(what, ": half-width ", halfWidth, " must be a number in (0, ", kMaxSdfHalfWidth, "] cell widths");
@@ -197,30 +186,18 @@ SdfBand signedDistanceBand(const Grid& grid, const Scene& scene, const SdfOption
     for (const Candidate& c : piece) band.keys.push_back(c.key), band.values.push_back(c.d2);
     std::vector<Candidate>().swap(piece);
   }
-  // Signs: an empty cell lies wholly on one side, which the fill decided; an occupied cell's centre is tested.
+  // Signs: InsideTest at every band cell's centre, as libvox.sdf and Grid.distance ask it.
   std::function<bool(double)> signProgress;
   if (options.progress) signProgress = [&](double f) { return options.progress(0.8 + 0.15 * f); };
-  const std::vector<uint8_t> centreInside = occupiedCentresInside(grid, scene, signProgress);
+  const InsideTest test(scene);
+  const std::vector<uint8_t> inside = centresInside(grid, test, band.keys, signProgress);
   std::atomic<uint64_t> done{0};
   std::atomic<bool> cancelled{false};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, band.keys.size(), 1024), [&](const tbb::blocked_range<size_t>& r) {
     if (cancelled) return;
-    // The band's keys ascend, as do the occupied cells' and the solid runs': one search each per block, then walks.
-    size_t cell =
-        std::lower_bound(grid.cellKeys.begin(), grid.cellKeys.end(), band.keys[r.begin()]) - grid.cellKeys.begin();
-    size_t run = std::upper_bound(grid.solidRuns.begin(), grid.solidRuns.end(), band.keys[r.begin()],
-                                  [](uint64_t k, const CellRun& s) { return k < s.first; }) -
-                 grid.solidRuns.begin();
-    run = run > 0 ? run - 1 : 0;  // the run that may hold the first key
     for (size_t b = r.begin(); b < r.end(); ++b) {
-      const uint64_t key = band.keys[b];
       const double d = std::sqrt(band.values[b]);
-      while (cell < grid.cellKeys.size() && grid.cellKeys[cell] < key) ++cell;
-      while (run < grid.solidRuns.size() && grid.solidRuns[run].first + grid.solidRuns[run].count <= key) ++run;
-      const bool occupied = cell < grid.cellKeys.size() && grid.cellKeys[cell] == key;
-      const bool solid = run < grid.solidRuns.size() && grid.solidRuns[run].first <= key;
-      const bool inside = occupied ? d > 0 && centreInside[cell] : solid;
-      band.values[b] = inside ? -d : d;
+      band.values[b] = d > 0 && inside[b] ? -d : d;  // a centre on the surface: +0
     }
     const uint64_t finished = done += r.size();
     if (options.progress && !options.progress(0.95 + 0.05 * double(finished) / double(band.keys.size())))
@@ -247,20 +224,9 @@ VoxelizeOptions withCubicCells(const Scene& scene, VoxelizeOptions options) {
   return options;
 }
 
-void storeSignedDistances(Grid& grid, const Scene& scene, const SdfOptions& options, bool filled) {
-  checkSdfHalfWidth(options.halfWidth, "--sdf");
-  std::vector<CellRun> ownRuns;
-  SdfOptions bandOptions = options;
-  if (!filled) {
-    ownRuns = std::move(grid.solidRuns);
-    FillOptions fo;
-    fo.memoryLimitBytes = options.memoryLimitBytes;
-    if (options.progress) fo.progress = [&](double f) { return options.progress(f / 3); };
-    fillSolid(grid, scene, fo);
-    if (options.progress) bandOptions.progress = [&](double f) { return options.progress((1 + 2 * f) / 3); };
-  }
-  SdfBand band = signedDistanceBand(grid, scene, bandOptions);
-  if (!filled) grid.solidRuns = std::move(ownRuns);
+void storeSignedDistances(Grid& grid, const Scene& scene, const SdfOptions& options, bool /*filled*/) {
+  // The signs come from InsideTest, not from the fill: nothing to fill on the side.
+  SdfBand band = signedDistanceBand(grid, scene, options);
   grid.sdfHalfWidth = options.halfWidth;
   grid.sdfKeys = std::move(band.keys);
   grid.sdfValues = std::move(band.values);

@@ -478,8 +478,15 @@ int64_t neighbourK(const Grid& grid, const RowTable& t, const HoleCaps& caps, co
 struct FillWinding {
   SceneWinding scene;
   HoleCaps caps;
+  double yzLo[2] = {INFINITY, INFINITY}, yzHi[2] = {-INFINITY, -INFINITY};  // the (y, z) box of every primitive
   FillWinding(const Scene& s, std::vector<OpenBoundary>&& boundaries, const Grid& grid)
-      : scene(s), caps(std::move(boundaries), grid.method == OverlapMethod::Center) {}
+      : scene(s), caps(std::move(boundaries), grid.method == OverlapMethod::Center) {
+    const size_t nTri = s.triangles.size();
+    for (size_t id = 0; id < s.boundedCount(); ++id) {
+      const Box b = id < nTri ? triangleBounds(s.triangles[id]) : sphereBounds(s.spheres[id - nTri]);
+      for (int a = 0; a < 2; ++a) yzLo[a] = std::min(yzLo[a], b.lo[a + 1]), yzHi[a] = std::max(yzHi[a], b.hi[a + 1]);
+    }
+  }
 };
 
 namespace {
@@ -583,7 +590,9 @@ FillReport startFill(const Grid& grid, const Scene& scene, const FillOptions& op
                      options.memoryLimitBytes >> 20, " MiB allowed");
   std::vector<OpenBoundary> boundaries = openBoundaries(scene.triangles, &report.openEdges, kMaxCapBoundaries);
   CancelCheck{&options, 0}();  // the edge weld and the tree build: 0.03 s each for the bunny
-  report.rule = report.openEdges > 0 || report.leakyMethod ? FillRule::WindingNumber : FillRule::Enclosed;
+  report.boundsCut = !grid.outsidePrims.empty();
+  report.rule =
+      report.openEdges > 0 || report.leakyMethod || report.boundsCut ? FillRule::WindingNumber : FillRule::Enclosed;
   if (options.rule) report.rule = *options.rule;
   if (report.rule == FillRule::WindingNumber)
     winding = std::make_shared<const FillWinding>(scene, std::move(boundaries), grid);
@@ -602,12 +611,68 @@ std::vector<uint8_t> enclosedGaps(const RowTable& t, UnionFind& uf, const IsOuts
   return enclosed;
 }
 
+// Under cut bounds (FillReport::boundsCut): the solid runs of the rows of [ownRows[0], ownRows[1]) that hold no
+// occupied cell, which the table does not list (otherwise a row without a surface cell is outside by definition).
+// Each is one empty run, decided as the fill decides its runs (decideRun, by winding number). A row whose line
+// misses the (y, z) box of every primitive is outside: a surface lying in a half-space not holding the point has
+// |w| < 1/2 there.
+std::vector<CellRun> bareRowRuns(const Grid& grid, const FillWinding& winding, const RowTable& t,
+                                 std::array<uint64_t, 2> ownRows, const FillOptions& options, FillReport& report) {
+  const uint64_t nx = grid.dims[0], ny = grid.dims[1];
+  const std::array<std::vector<double>, 3> centres = cellCentresByAxis(grid);
+  // The bare rows in ascending order, a block at a time (each block's runs are sorted; blocks concatenate).
+  const uint64_t count = ownRows[1] - ownRows[0];
+  const uint64_t blockRows = 4096, blocks = (count + blockRows - 1) / blockRows;
+  std::vector<std::vector<CellRun>> pieces(blocks);
+  std::atomic<uint64_t> evaluations{0};
+  std::atomic<bool> cancelled{false};
+  tbb::parallel_for(uint64_t(0), blocks, [&](uint64_t b) {
+    if (cancelled) return;
+    const uint64_t lo = ownRows[0] + b * blockRows, hi = std::min(ownRows[1], lo + blockRows);
+    size_t listed = size_t(std::lower_bound(t.row.begin(), t.row.end(), lo) - t.row.begin());
+    uint64_t n = 0;
+    for (uint64_t row = lo; row < hi; ++row) {
+      while (listed < t.row.size() && t.row[listed] < row) ++listed;
+      if (listed < t.row.size() && t.row[listed] == row) continue;
+      const double y = centres[1][row % ny], z = centres[2][row / ny];
+      if (y < winding.yzLo[0] || y > winding.yzHi[0] || z < winding.yzLo[1] || z > winding.yzHi[1]) continue;
+      const Piece p = decideRun(0, uint32_t(nx - 1), [&](uint32_t x) {
+        ++n;
+        return std::abs(winding.scene.at({centres[0][x], y, z})) >= kWindingThreshold;
+      });
+      if (p.lo <= p.hi) pieces[b].push_back({row * nx + p.lo, uint64_t(p.hi) - p.lo + 1});
+    }
+    evaluations += n;
+    if (options.progress && !options.progress(1)) cancelled = true;
+  });
+  if (cancelled) fail<Error>("solid fill cancelled");
+  report.windingQueries += evaluations;
+  std::vector<CellRun> runs;
+  for (const auto& piece : pieces) runs.insert(runs.end(), piece.begin(), piece.end());
+  return runs;
+}
+
+// Two sorted lists of disjoint runs merged into one, runs that touch joined.
+std::vector<CellRun> mergeRuns(const std::vector<CellRun>& a, const std::vector<CellRun>& b) {
+  std::vector<CellRun> out;
+  out.reserve(a.size() + b.size());
+  size_t i = 0, j = 0;
+  while (i < a.size() || j < b.size()) {
+    const CellRun r = j == b.size() || (i < a.size() && a[i].first < b[j].first) ? a[i++] : b[j++];
+    if (!out.empty() && out.back().first + out.back().count == r.first)
+      out.back().count += r.count;
+    else
+      out.push_back(r);
+  }
+  return out;
+}
+
 // The solid runs of the table's rows from `firstRow` on, sorted and merged where they touch, under report.rule;
 // adds their counts to `report`. The serial loops ask options.progress (the gather after the sweeps: 0.24 s at
 // 2048^3 for the bunny).
 std::vector<CellRun> solidRuns(const Grid& grid, const FillWinding* winding, const RowTable& t,
                                const std::vector<uint8_t>& enclosed, size_t firstRow, const FillOptions& options,
-                               FillReport& report) {
+                               FillReport& report, std::array<uint64_t, 2> ownRows) {
   const CancelCheck before{&options, 0}, check{&options, 1};  // the fraction before the sweeps and after
   std::vector<CellRun> runs;
   uint64_t enclosedCells = 0;
@@ -650,6 +715,11 @@ std::vector<CellRun> solidRuns(const Grid& grid, const FillWinding* winding, con
       else
         runs.push_back({first, count});
     }
+  }
+  if (report.boundsCut && winding) {
+    std::vector<CellRun> bare = bareRowRuns(grid, *winding, t, ownRows, options, report);
+    for (const CellRun& r : bare) solid += r.count;
+    runs = mergeRuns(runs, bare);
   }
   if (options.windingOnly) enclosedCells = 0;
   report.solidCells += solid;
@@ -697,7 +767,8 @@ FillReport fillSolid(Grid& grid, const Scene& scene, const FillOptions& options)
     enclosed = enclosedGaps(
         table, uf, [&](uint64_t root) { return root == outside; }, check);
   }
-  grid.solidRuns = solidRuns(grid, winding.get(), table, enclosed, 0, options, report);
+  grid.solidRuns =
+      solidRuns(grid, winding.get(), table, enclosed, 0, options, report, {0, uint64_t(grid.dims[1]) * grid.dims[2]});
   if (options.progress && !options.progress(1.0)) fail<Error>("solid fill cancelled");
   return report;
 }
@@ -706,6 +777,7 @@ SlabFill::SlabFill(const Grid& plan, const Scene& scene, const FillOptions& opti
   plan_.bounds = plan.bounds;
   plan_.dims = plan.dims;
   plan_.method = plan.method;
+  plan_.outsidePrims = plan.outsidePrims;
   report_ = startFill(plan_, scene, options, winding_);
 }
 
@@ -801,7 +873,8 @@ std::vector<CellRun> SlabFill::fill(std::span<const uint64_t> keys, uint32_t k0,
   });
   report_.emptyCells += (k1 - k0) * uint64_t(plan_.dims[0]) * plan_.dims[1] - keys.size();
   std::vector<CellRun> runs =
-      solidRuns(s.grid, winding_.get(), s.table, enclosed, s.firstRow, slabOptions(k0, k1, true), report_);
+      solidRuns(s.grid, winding_.get(), s.table, enclosed, s.firstRow, slabOptions(k0, k1, true), report_,
+                {uint64_t(k0) * plan_.dims[1], uint64_t(k1) * plan_.dims[1]});
   ++slab_;
   if (options_.progress && !slabOptions(k0, k1, true).progress(1.0)) fail<Error>("solid fill cancelled");
   return runs;
@@ -814,10 +887,11 @@ std::string describeFill(const FillReport& r) {
     return out.str();
   }
   out << "|winding number| >= " << kWindingThreshold << " (";
-  if (r.openEdges > 0) out << "mesh has " << r.openEdges << " open edges";
-  if (r.openEdges > 0 && r.leakyMethod) out << "; ";
-  if (r.leakyMethod) out << "method center leaves gaps in surfaces";
-  if (r.openEdges == 0 && !r.leakyMethod) out << "asked for: closed cavities stay empty";
+  const char* sep = "";
+  if (r.openEdges > 0) out << "mesh has " << r.openEdges << " open edges", sep = "; ";
+  if (r.leakyMethod) out << sep << "method center leaves gaps in surfaces", sep = "; ";
+  if (r.boundsCut) out << sep << "the bounds cut the scene", sep = "; ";
+  if (*sep == 0) out << "asked for: closed cavities stay empty";
   out << "), " << r.solidCells << " solid cells (" << r.enclosedCells << " enclosed, " << r.windingCells
       << " by winding number, " << r.windingQueries << " evaluations";
   if (r.capQueries > 0) out << ", " << r.capQueries << " of the hole caps alone";

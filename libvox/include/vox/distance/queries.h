@@ -23,8 +23,8 @@ struct DistanceQueryOptions {
 
 // The signed distance (world units, negative inside) at the centre of every cell, written to
 // out[i * strides[0] + j * strides[1] + k * strides[2]]: the Euclidean distance to the nearest bounded primitive,
-// signed as the band signs it (empty cells by the fill, occupied cells' centres by InsideTest). Precondition:
-// grid.solidRuns as fillSolid set them for `scene`, and `out` spans every index. A scene without bounded primitives
+// signed as the band signs it (InsideTest at every centre; grid.solidRuns are not used). Precondition: `out` spans
+// every index. A scene without bounded primitives
 // gives +infinity. Work spread over the caller's TBB arena; the result does not depend on the thread count.
 void denseSignedDistances(const Grid& grid, const Scene& scene, std::span<double> out,
                           const std::array<uint64_t, 3>& strides, const DistanceQueryOptions& options = {});

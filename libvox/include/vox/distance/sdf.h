@@ -13,6 +13,7 @@
 #include "vox/core/math.h"
 #include "vox/core/scene.h"
 #include "vox/distance/closest_point.h"
+#include "vox/voxelize/open_edges.h"
 #include "vox/voxelize/voxelize.h"
 #include "vox/voxelize/winding_number.h"
 
@@ -35,15 +36,48 @@ struct SdfBand {
 };
 
 // Which side of the solid a point is on: inside a sphere or an ellipsoid, or where the triangles' generalized
-// winding number has magnitude >= kWindingThreshold: the test `--fill` applies to its runs (fill.h), so a closed
-// surface decides exactly, an open or self-intersecting one as the fill does.
+// winding number w has magnitude >= kWindingThreshold (the fill's rule, fill.h). Every signed distance asks it (the
+// band, libvox.sdf, Grid.distance), so their signs agree bit for bit. Decided exactly, without evaluating w where
+// it can: the mesh closed by the caps of its holes (openBoundaries) has an integer winding number k, and w = k - s,
+// s the caps'. k at p is the signed count of the crossings of p's row line (along x) before p, each decided exactly
+// (orient2d against the triangle's edges with the line perturbed symbolically, so an edge or a vertex on the line
+// counts once; orient3d against its plane); the triangles whose (y, z) box holds the line come from a tree. Far
+// from every hole (capWindingBound < kCapBoundForInteger) k alone decides; nearer, s comes from the caps' tree, and
+// where |k - s| is within 0.25 of the threshold it is summed over the caps' triangles (exact to rounding there: the
+// decision is w's unless |w| is within about 1e-12 of the threshold or the tree errs by 0.25); a point on a cap
+// takes w summed over every triangle. A closed, consistently oriented mesh has no caps: exact. More
+// than kMaxCapBoundaries holes (a soup) fall back to the winding tree (windingNumberToDecide, about 1e-3 off).
 class InsideTest {
  public:
   explicit InsideTest(const Scene& scene);
   bool inside(const Vec3& p) const;
 
+  // A crossing of a row line with a triangle (index into the test's triangles: the mesh's, then the caps').
+  struct Crossing {
+    uint32_t triangle;
+    int sign;         // of the triangle normal's x component
+    double xlo, xhi;  // the triangle's x extent: a point beyond it is past the crossing without a predicate
+  };
+  // The crossings of the line (y, z) = (qy, qz) along x, in any order, into `out` (cleared).
+  void rowCrossings(double qy, double qz, std::vector<Crossing>& out) const;
+  // inside(p) from rowCrossings(p.y, p.z): a row's cells share the crossings, found once.
+  bool inside(const Vec3& p, const std::vector<Crossing>& crossings) const;
+
  private:
-  WindingTree tree_;
+  struct LineNode {
+    double lo[2], hi[2];  // (y, z) box
+    uint32_t first = 0;   // leaf: first slot in order_; inner: the second child (the first is the next node)
+    uint32_t count = 0;   // triangles of a leaf; 0 for an inner node
+  };
+  uint32_t buildLineTree(uint32_t begin, uint32_t end);
+  std::vector<Triangle> triangles_;  // the mesh's, then the caps'
+  size_t meshCount_ = 0;
+  std::vector<OpenBoundary> boundaries_;
+  bool counted_ = false;  // caps built (at most kMaxCapBoundaries holes): k - s; otherwise the tree
+  std::vector<LineNode> lineNodes_;
+  std::vector<uint32_t> order_;
+  WindingTree tree_;     // a soup's
+  WindingTree capTree_;  // the caps'
   std::vector<EllipsoidShape> shapes_;
 };
 
@@ -51,10 +85,10 @@ class InsideTest {
 void checkSdfHalfWidth(double halfWidth, const char* what);
 
 // The band: every cell whose centre lies within halfWidth smallest cell edges of a bounded primitive, with its
-// signed distance. The sign of an empty cell is its fill status (precondition: grid.solidRuns as fillSolid set
-// them for this scene); an occupied cell's centre gets InsideTest. Work spread over the caller's TBB arena; the
-// result does not depend on the thread count. Throws UsageError for a bad half-width, LimitError past the memory
-// limit, vox::Error when cancelled.
+// signed distance, negative where InsideTest says inside (every cell, occupied or not: grid.solidRuns are not
+// used, so a cavity that the flood fill fills keeps the winding number's sign). Work spread over the caller's TBB
+// arena; the result does not depend on the thread count. Throws UsageError for a bad half-width, LimitError past the
+// memory limit, vox::Error when cancelled.
 SdfBand signedDistanceBand(const Grid& grid, const Scene& scene, const SdfOptions& options = {});
 
 // Options whose cells are exactly cubic, for distances: with a resolution and no bounds, the bounds grown about the
@@ -63,8 +97,7 @@ SdfBand signedDistanceBand(const Grid& grid, const Scene& scene, const SdfOption
 VoxelizeOptions withCubicCells(const Scene& scene, VoxelizeOptions options);
 
 // signedDistanceBand stored in `grid` (sdfHalfWidth, sdfKeys, sdfValues), what vox-voxelize --sdf and
-// libvox.voxelize(sdf=) do. `filled`: grid.solidRuns are fillSolid's for this scene; otherwise the fill runs on the
-// side first (its runs are not kept, and its progress is the first third of options.progress).
+// libvox.voxelize(sdf=) do. `filled` is kept for callers: the signs no longer need the fill.
 void storeSignedDistances(Grid& grid, const Scene& scene, const SdfOptions& options, bool filled);
 
 }  // namespace vox

@@ -20,8 +20,9 @@ enum class FillRule : uint8_t {
   // 6-connected path of empty cells joins it to the outside of the grid. Exact for a conservative (exact, sat, bbox)
   // voxelization of closed surfaces: the cells inside that meet no surface.
   Enclosed,
-  // The mesh has open edges, or the voxelization (`center`) leaves gaps in closed surfaces: the enclosed cells as
-  // above, and also the cells of the other empty runs along x (in rows that hold a surface cell) whose centre has a
+  // The mesh has open edges, the voxelization (`center`) leaves gaps in closed surfaces, or user bounds cut the
+  // scene (then also each row without a surface cell, decided as a run): the enclosed cells as above, and also the
+  // cells of the other empty runs along x (in rows that hold a surface cell) whose centre has a
   // generalized winding number (winding_number.h, spheres counting 1 inside) of magnitude at least
   // kWindingThreshold. Evaluated at both ends of each run; a run whose ends disagree is split by bisection. Most
   // runs are decided through the holes' caps (fill.cpp, HoleCaps), with the same result.
@@ -47,8 +48,11 @@ struct FillOptions {
 
 struct FillReport {
   FillRule rule = FillRule::Enclosed;
-  uint64_t openEdges = 0;       // countOpenEdges of the scene's triangles
-  bool leakyMethod = false;     // the grid's method is `center`, whose surfaces have gaps
+  uint64_t openEdges = 0;    // countOpenEdges of the scene's triangles
+  bool leakyMethod = false;  // the grid's method is `center`, whose surfaces have gaps
+  // User bounds cut the scene (grid.outsidePrims): the grid's faces are not outside, so the runs that reach them and
+  // the rows without a surface cell are decided by winding number too (the WindingNumber rule).
+  bool boundsCut = false;
   uint64_t enclosedCells = 0;   // solid because enclosed (both rules)
   uint64_t windingCells = 0;    // solid because of the winding number (WindingNumber rule only)
   uint64_t windingQueries = 0;  // winding numbers of the scene evaluated

@@ -1,5 +1,10 @@
 #include "options.h"
 
+#include <algorithm>
+#include <cstring>
+#include <utility>
+#include <vector>
+
 #include "../common/cli_app.h"
 
 #include "../common/grid_flags.h"
@@ -56,11 +61,46 @@ VoxelizeOptions voxelizeOptions(const Options& opt) {
   return cli::voxelizeOptionsFromFlags(opt.method, opt.grid, opt.resolution, opt.bounds);
 }
 
+namespace {
+
+// "--sdf SCENE -o OUT": --sdf takes 0 or 1 value, and CLI11 takes the scene's path as HALF (then misses the scene).
+// A token after --sdf that is neither a number nor an option cannot be HALF: moved before --sdf, it is the
+// positional scene. Used only when the command line so read is valid (parsesQuietly), so that "SCENE --sdf x" keeps
+// its own message ("HALF x is not a number").
+std::vector<char*> sceneBeforeBareSdf(int argc, char** argv) {
+  std::vector<char*> args(argv, argv + argc);
+  for (size_t i = 1; i + 1 < args.size(); ++i) {
+    if (std::strcmp(args[i], "--") == 0) break;
+    const char* next = args[i + 1];
+    double number = 0;
+    if (std::strcmp(args[i], "--sdf") == 0 && next[0] != '\0' && next[0] != '-' &&
+        !CLI::detail::lexical_cast(std::string(next), number))
+      std::swap(args[i], args[i + 1]), ++i;
+  }
+  return args;
+}
+
+bool parsesQuietly(std::vector<char*> args) {
+  Options scratch;
+  CLI::App app{"", "vox-voxelize"};
+  addOptions(app, scratch);
+  try {
+    app.parse(int(args.size()), args.data());
+    return true;
+  } catch (const CLI::Error&) {
+    return false;
+  }
+}
+
+}  // namespace
+
 std::optional<int> parseCommandLine(int argc, char** argv, Options& opt) {
   CLI::App app{"Voxelize a scene (.txt course format, .obj, .gltf, .glb, .ply) into a sparse grid file (.vgrid).",
                "vox-voxelize"};
   addOptions(app, opt);
-  const std::optional<int> exit = cli::parse(app, argc, argv);
+  std::vector<char*> args = sceneBeforeBareSdf(argc, argv);
+  if (!std::equal(args.begin(), args.end(), argv) && !parsesQuietly(args)) args.assign(argv, argv + argc);
+  const std::optional<int> exit = cli::parse(app, int(args.size()), args.data());
   opt.fill = opt.fill || opt.fraction;  // a fraction's cells inside are the fill's solid cells (DESIGN.md)
   return exit;
 }

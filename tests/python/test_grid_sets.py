@@ -56,16 +56,17 @@ def test_bricks_of_a_grid_with_fractions_or_distances_are_refused_before_anythin
 
 
 def test_a_bricked_save_loads_back_as_the_grid(tmp_path):
-    """The fill of a hollow box (the cavity filled as enclosed), an open box (winding number), cut bounds: the set is
-    the grid, for bricks from one to one cell each."""
+    """The fill of a hollow box (the cavity filled as enclosed), an open box (winding number), cells that are not
+    cubes: the set is the grid, for bricks from one to one cell across (x and y)."""
     v, f = hollow_box()
     bv, bf = box((0, 0, 0), (1, 1, 1))
+    wide = ((-0.2, -0.1, -0.15), (1.2, 1.1, 1.05))
     grids = [libvox.voxelize((v, f), resolution=16, fill=True),
-             libvox.voxelize((bv, bf[:10]), resolution=12, fill=True),  # two faces missing
-             libvox.voxelize((v, f), dims=(9, 8, 7), bounds=((0.2, 0.1, -0.1), (0.9, 0.8, 0.6)), fill=True)]
+             libvox.voxelize((bv, bf[:10]), dims=12, bounds=wide, fill=True),  # a face missing
+             libvox.voxelize((v, f), dims=(9, 8, 7), bounds=wide, fill=True)]
     for g in grids:
         assert g.solid_count > 0
-        for bricks in [1, 2, (3, 1, 2), g.dims]:
+        for bricks in [1, 2, (3, 1, 2), (g.dims[0], g.dims[1], 1)]:
             path = tmp_path / "s.vgrid"
             g.save(path, bricks=bricks)
             assert_same_grid(libvox.load(path), g)

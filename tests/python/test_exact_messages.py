@@ -14,8 +14,9 @@ def cube():
 
 
 @pytest.mark.parametrize("half,shown", [(64.0000001, "64.0000001"), (float(np.nextafter(64, 65)), "64.00000000000001"),
-                                        (1e-320 * -1, "-1e-320"), (-0.0, "-0")])
+                                        (-1e-320, "-1e-320"), (-0.0, "-0")])
 def test_sdf_half_width_out_of_range_is_shown_as_given(half, shown):
-    with pytest.raises(libvox.UsageError, match=rf"^sdf: half-width {shown} must be a number in \(0, 64\] cell widths$"):
+    message = rf"^sdf: half-width {shown} must be a number in \(0, 64\] cell widths$"
+    with pytest.raises(libvox.UsageError, match=message):
         libvox.voxelize(cube(), resolution=4, sdf=half)
 

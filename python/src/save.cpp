@@ -1,4 +1,5 @@
 // Grid.save: every output of vox-voxelize and vox-export, by extension, through the same library calls.
+#include <cstdio>
 #include <filesystem>
 
 #include "binding.h"
@@ -83,10 +84,14 @@ void save(PyGrid& self, const py::object& pathObj, const py::object& facesName, 
       vox::writeVoxelMesh(*path, mesh, !ascii);
     }
   });
-  if (voxelFormat == vox::VoxelFormat::Binvox && report.binvoxShiftVoxels > 1e-9)
+  if (voxelFormat == vox::VoxelFormat::Binvox && report.binvoxShiftVoxels > 1e-9) {
+    // vox-export's numbers (%.9g, %.3g): std::to_string's 6 decimals showed a side of 1e-7 as 0.000000.
+    char numbers[2][32];
+    std::snprintf(numbers[0], sizeof numbers[0], "%.9g", report.binvoxVoxelSide);
+    std::snprintf(numbers[1], sizeof numbers[1], "%.3g", report.binvoxShiftVoxels);
     warn(*path + ": binvox voxels are cubes; the grid's cells are not, so they are written as cubes of side " +
-         std::to_string(report.binvoxVoxelSide) + " (the longest axis' cell) and the grid's far face moves by up to " +
-         std::to_string(report.binvoxShiftVoxels) + " voxels");
+         numbers[0] + " (the longest axis' cell) and the grid's far face moves by up to " + numbers[1] + " voxels");
+  }
   if (report.paletteReduced)
     warn(*path + ": " + std::to_string(report.gridColors) + " voxel colours reduced to a palette of " +
          std::to_string(report.paletteColors) + " (median cut)");

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <random>
@@ -248,6 +249,62 @@ TEST(GridFile, BadSolidRunsAndUnknownSectionsAreRefused) {
   // A section header promising more bytes than remain.
   bytes.resize(bytes.size() - 2);
   EXPECT_THROW(decodeGridFile(resum(bytes), "tag.vgrid"), InputError);
+}
+
+// Issue 45, defects 13 and 14: the Distances and Fractions sections of a grid that has both. A file holding them out
+// of order (Fractions, tag 6, before Distances, tag 5) is refused, and values out of range are printed as they are
+// (not -1e-300 as "-0.000000", nor the next double above 64 as "64" beside the limit 64), with the range.
+TEST(GridFile, SectionsOutOfOrderAndBadBandOrFractionValuesAreRefusedExactly) {
+  const Scene scene = testing::boxScene(0.2, 0.8);
+  VoxelizeOptions opt;
+  opt.dims = {4, 4, 4};
+  Grid grid = voxelizeScene(scene, opt);
+  grid.sdfHalfWidth = 2;
+  grid.sdfKeys = {grid.cellKeys[0], grid.cellKeys[1]};
+  grid.sdfValues = {0.125, -0.25};
+  grid.fractions.assign(grid.occupiedCount(), 0.5);
+  const std::string good = encodeGridFile(scene, grid);
+  ASSERT_NO_THROW(decodeGridFile(good, "ok.vgrid"));
+  const size_t fractionsBytes = 12 + 8 + 8 * grid.occupiedCount(), distancesBytes = 12 + 8 + 8 + 16 * 2;
+  const size_t distancesAt = good.size() - fractionsBytes - distancesBytes;
+  std::string swapped = good.substr(0, distancesAt) + good.substr(good.size() - fractionsBytes) +
+                        good.substr(distancesAt, distancesBytes);
+  ASSERT_EQ(swapped.size(), good.size());
+  auto refusal = [](const std::string& bytes) {
+    try {
+      decodeGridFile(resum(bytes), "g.vgrid");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(refusal(swapped).find("distances section (tag 5) after the fractions section (tag 6)"), std::string::npos)
+      << refusal(swapped);
+  const struct {
+    double halfWidth, fraction;
+    const char* message;
+  } cases[] = {
+      {2, -1e-300, "volume fraction -1e-300 outside [0, 1]"},
+      {2, 1.0000000000000002, "volume fraction 1.0000000000000002 outside [0, 1]"},
+      {std::nextafter(64.0, 65.0), 0.5, "distance band half-width 64.00000000000001 outside (0, 64] cell edges"},
+      {-0.0, 0.5, "distance band half-width -0 outside (0, 64] cell edges"},
+      {5e-324, 0.5, ""},  // the smallest positive double is a valid half-width
+  };
+  for (const auto& c : cases) {
+    Grid g = grid;
+    g.sdfHalfWidth = c.halfWidth;
+    g.fractions.back() = c.fraction;
+    std::string bytes = encodeGridFile(scene, g);
+    if (c.halfWidth == 0) {  // a zero half-width writes no Distances section: put -0 into the file's own
+      bytes = good;
+      std::memcpy(&bytes[distancesAt + 12], &c.halfWidth, 8);
+    }
+    const std::string got = refusal(bytes);
+    if (*c.message == 0)
+      EXPECT_EQ(got, "accepted");
+    else
+      EXPECT_NE(got.find(c.message), std::string::npos) << got;
+  }
 }
 
 TEST(GridFile, WrittenFileEqualsTheEncodingAcrossChunks) {

@@ -21,6 +21,7 @@
 #include "vox/import/import.h"
 #include "vox/sets/fill_set.h"
 #include "vox/sets/voxelize_set.h"
+#include "vox/volume/fractions.h"
 #include "vox/voxelize/bricks.h"
 
 namespace vox {
@@ -375,6 +376,90 @@ TEST(GridSet, FillEqualsTheSingleGridsFill) {
       EXPECT_EQ(solid, want.solidCells) << what;
     }
   }
+}
+
+// Issue 45, defect 4: a hollow box (an outer shell facing out, an inner one facing in) filled as --fraction fills it,
+// by winding number (the cavity stays empty); the flood fill a re-voxelized set runs would fill the cavity too.
+struct HollowBox {
+  Scene scene = testing::boxScene(0.1, 0.9);
+  Grid grid;
+};
+HollowBox hollowBox(std::array<uint32_t, 3> dims) {
+  HollowBox b;
+  for (Triangle t : testing::boxScene(0.3, 0.7).triangles) {
+    std::swap(t.v[1], t.v[2]);  // inward
+    b.scene.triangles.push_back(t);
+  }
+  VoxelizeOptions o;
+  o.dims = dims;
+  o.bounds = Box{{0, 0, 0}, {1, 1, 1}};
+  b.grid = voxelizeScene(b.scene, o);
+  fillSolid(b.grid, b.scene, fillForFractions({}));
+  return b;
+}
+
+void expectSameRuns(const Grid& a, const Grid& b, const std::string& what) {
+  ASSERT_EQ(a.solidRuns.size(), b.solidRuns.size()) << what;
+  for (size_t r = 0; r < a.solidRuns.size(); ++r) {
+    EXPECT_EQ(a.solidRuns[r].first, b.solidRuns[r].first) << what << " run " << r;
+    EXPECT_EQ(a.solidRuns[r].count, b.solidRuns[r].count) << what << " run " << r;
+  }
+}
+
+TEST(GridSet, AGridWrittenAsASetReadsBackAsTheGrid) {
+  testing::ScratchDir dir("gridset_as_set");
+  const HollowBox box = hollowBox({14, 13, 12});
+  Grid flooded = box.grid;
+  fillSolid(flooded, box.scene);
+  ASSERT_GT(flooded.solidCount(), box.grid.solidCount());  // the case re-voxelizing got wrong: the fills differ
+  ASSERT_GT(box.grid.solidCount(), 100u);
+  for (const auto bricks : {std::array<uint32_t, 3>{1, 1, 1}, {2, 2, 2}, {7, 5, 3}, {14, 1, 12}, {14, 13, 12}}) {
+    const std::string what =
+        std::to_string(bricks[0]) + "x" + std::to_string(bricks[1]) + "x" + std::to_string(bricks[2]) + " bricks";
+    const std::string path = dir.file("h.vgrid");
+    const GridSetManifest m = writeGridAsSet(path, box.scene, box.grid, bricks);
+    const GridFile set = readGridSet(path);
+    expectSameGrid(set.grid, box.grid);
+    expectSameRuns(set.grid, box.grid, what);
+    EXPECT_EQ(encodeGridFile(set.scene, set.grid), encodeGridFile(box.scene, box.grid)) << what;
+    EXPECT_EQ(readGridSetManifest(path).entries.size(), m.entries.size()) << what;
+    // Only this set's files are left: the manifest, the scene file, its bricks.
+    EXPECT_EQ(setFiles(dir).size(), 2 + m.entries.size()) << what;
+  }
+}
+
+// Defects 4 and 5: a refusal (distances or fractions, which a set cannot hold; bricks out of range) or a cancel comes
+// before the old output is replaced: the old set stays whole and no new file is left.
+TEST(GridSet, AGridAsASetIsRefusedOrCancelledBeforeTheOldOutputIsReplaced) {
+  testing::ScratchDir dir("gridset_as_set_keep");
+  const HollowBox box = hollowBox({10, 9, 8});
+  const std::string path = dir.file("h.vgrid");
+  writeGridAsSet(path, box.scene, box.grid, {2, 2, 2});
+  const std::vector<std::string> before = setFiles(dir);
+  const std::string manifest = slurp(path);
+  Grid withFractions = box.grid;
+  withFractions.fractions.assign(withFractions.occupiedCount(), 0.5);
+  Grid withBand = box.grid;
+  withBand.sdfHalfWidth = 2;
+  withBand.sdfKeys = {0};
+  withBand.sdfValues = {0.25};
+  for (const Grid* g : {&withFractions, &withBand}) {
+    try {
+      writeGridAsSet(path, box.scene, *g, {2, 2, 2});
+      ADD_FAILURE() << "wrote a set that drops the grid's distances or fractions";
+    } catch (const UsageError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("bricks: a grid set holds no signed distances or volume fractions", 0), 0u)
+          << e.what();
+    }
+  }
+  EXPECT_THROW(writeGridAsSet(path, box.scene, box.grid, {11, 1, 1}), UsageError);
+  for (const int calls : {1, 2, 5, 9}) {
+    auto left = std::make_shared<int>(calls);
+    EXPECT_THROW(writeGridAsSet(path, box.scene, box.grid, {3, 2, 2}, [left](double) { return --*left > 0; }), Error);
+  }
+  EXPECT_EQ(setFiles(dir), before);
+  EXPECT_EQ(slurp(path), manifest);
+  expectSameRuns(readGridSet(path).grid, box.grid, "the old set");
 }
 
 // A closed box in a 9x8x7 grid over the unit cube, filled, so that solid runs cross brick faces.

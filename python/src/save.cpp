@@ -1,4 +1,5 @@
 // Grid.save: every output of vox-voxelize and vox-export, by extension, through the same library calls.
+#include <cstdio>
 #include <filesystem>
 
 #include "binding.h"
@@ -9,7 +10,6 @@
 #include "vox/io/atomic_file.h"
 #include "vox/io/grid_set.h"
 #include "vox/io/input_file.h"
-#include "vox/sets/voxelize_set.h"
 #include "vox/voxelize/bricks.h"
 
 namespace voxpy {
@@ -25,35 +25,6 @@ std::string lowerExtension(const std::string& path) {
 bool isGridFilePath(const std::string& path) { return lowerExtension(path) == ".vgrid"; }
 bool isViewerPagePath(const std::string& path) {
   return lowerExtension(path) == ".html" || lowerExtension(path) == ".htm";
-}
-
-// A grid set of the grid (vox-voxelize --bricks): the set's writer voxelizes the grid's scene brick by brick under
-// the grid's own plan (bounds, dims, method; the fill when the grid has solid cells), which gives the grid's cells
-// (grid_set.h: a brick holds exactly the single grid's cells); the totals are checked against the grid's.
-void saveGridSet(const PyGrid& self, const std::string& path, const std::array<uint32_t, 3>& bricks,
-                 Interrupt& interrupt) {
-  const vox::Grid& grid = self.grid();
-  vox::VoxelizeOptions vo;
-  vo.bounds = grid.bounds;
-  vo.dims = grid.dims;
-  vo.method = grid.method;
-  vo.memoryLimitBytes = memoryBudget();
-  vo.progress = [&](double f) { return interrupt.poll(0.8 * f); };
-  vox::FillOptions fo;
-  fo.memoryLimitBytes = vo.memoryLimitBytes;
-  fo.progress = [&](double f) { return interrupt.poll(0.8 + 0.2 * f); };
-  const vox::GridSetManifest set =
-      vox::writeGridSet(path, self.scene(), vo, bricks, nullptr, grid.solidRuns.empty() ? nullptr : &fo);
-  uint64_t occupied = 0, references = 0, solid = 0;
-  for (const vox::BrickEntry& e : set.entries) {
-    occupied += e.occupied;
-    references += e.references;
-    solid += e.solid;
-  }
-  if (occupied != grid.occupiedCount() || references != grid.referenceCount() || solid != grid.solidCount())
-    vox::fail<vox::InputError>(self.source(), ": the grid's cells are not the voxelization of its scene (",
-                               grid.occupiedCount(), " occupied cells, the set has ", occupied,
-                               "): it cannot be written as a grid set");
 }
 
 void save(PyGrid& self, const py::object& pathObj, const py::object& facesName, const py::object& colorName,
@@ -76,6 +47,7 @@ void save(PyGrid& self, const py::object& pathObj, const py::object& facesName, 
     if (!gridFile) vox::fail<vox::UsageError>("bricks: only a .vgrid output is written as a grid set");
     bricks = dims3Arg(bricksArg, "bricks", UINT32_MAX);
     vox::checkBrickCounts(self.grid().dims, *bricks);
+    vox::checkGridSetHolds(self.grid(), "bricks");  // as vox-voxelize refuses --bricks with --sdf or --fraction
   }
   vox::checkOutputPath(*path, inputs);
   if (!gridFile && !voxelFormat && !page && vox::meshFormatFromPath(*path) == vox::MeshFormat::Obj)
@@ -89,7 +61,9 @@ void save(PyGrid& self, const py::object& pathObj, const py::object& facesName, 
   runLong(interrupt, nThreads, [&] {
     const vox::Grid& grid = self.grid();
     if (gridFile && bricks) {
-      saveGridSet(self, *path, *bricks, interrupt);
+      // The grid's own cells, split into bricks: the set read back is the grid (vox-voxelize --bricks voxelizes
+      // brick by brick instead, to keep one brick in memory; here the whole grid is in memory already).
+      vox::writeGridAsSet(*path, self.scene(), grid, *bricks, [&](double f) { return interrupt.poll(f); });
     } else if (gridFile) {
       vox::writeGridFile(*path, self.scene(), grid);
     } else if (page) {
@@ -110,10 +84,14 @@ void save(PyGrid& self, const py::object& pathObj, const py::object& facesName, 
       vox::writeVoxelMesh(*path, mesh, !ascii);
     }
   });
-  if (voxelFormat == vox::VoxelFormat::Binvox && report.binvoxShiftVoxels > 1e-9)
+  if (voxelFormat == vox::VoxelFormat::Binvox && report.binvoxShiftVoxels > 1e-9) {
+    // vox-export's numbers (%.9g, %.3g): std::to_string's 6 decimals showed a side of 1e-7 as 0.000000.
+    char numbers[2][32];
+    std::snprintf(numbers[0], sizeof numbers[0], "%.9g", report.binvoxVoxelSide);
+    std::snprintf(numbers[1], sizeof numbers[1], "%.3g", report.binvoxShiftVoxels);
     warn(*path + ": binvox voxels are cubes; the grid's cells are not, so they are written as cubes of side " +
-         std::to_string(report.binvoxVoxelSide) + " (the longest axis' cell) and the grid's far face moves by up to " +
-         std::to_string(report.binvoxShiftVoxels) + " voxels");
+         numbers[0] + " (the longest axis' cell) and the grid's far face moves by up to " + numbers[1] + " voxels");
+  }
   if (report.paletteReduced)
     warn(*path + ": " + std::to_string(report.gridColors) + " voxel colours reduced to a palette of " +
          std::to_string(report.paletteColors) + " (median cut)");
@@ -127,7 +105,8 @@ void bindSave(GridClass& grid) {
            py::arg("progress") = false, R"doc(
 Writes the grid in the format of the path's extension, as vox-voxelize and vox-export write it:
   .vgrid: the grid file with its scene (libvox.load and the tools read it); with bricks=(bx, by, bz), a grid set
-      as vox-voxelize --bricks writes it (its scene voxelized again brick by brick under the grid's plan);
+      in the layout vox-voxelize --bricks writes, holding the grid's own cells and solid runs split into bricks (a
+      set holds no signed distances or volume fractions: a grid with either is refused, UsageError);
   .ply .obj .off .stl .glb .gltf: the voxels as a mesh; faces 'all' (a cube per voxel), 'exposed' (closed,
       2-manifold) or 'merged' (exposed faces merged into rectangles); color 'count', 'material' or 'none';
       ascii=True for ASCII PLY/STL;

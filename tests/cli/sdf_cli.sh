@@ -110,6 +110,27 @@ head -n 18 "$tmp/box.obj" >"$tmp/open.obj"
 [ $? = 1 ] && [ ! -e "$tmp/open.vgrid" ] && grep -q 'open edges' "$tmp/err" && [ "$(wc -l <"$tmp/err")" = 1 ] ||
   fail "--fraction of an open mesh: $(cat "$tmp/err")"
 
+# Issue 45: a half-width just above the limit is printed as given (not "64", which reads as inside (0, 64]).
+"$build/vox-voxelize" "$cube" -o "$tmp/bad.vgrid" --res 8 --sdf 64.0000001 2>"$tmp/err"
+[ $? = 1 ] && grep -q 'half-width 64.0000001 must be a number in (0, 64]' "$tmp/err" ||
+  fail "--sdf 64.0000001: $(cat "$tmp/err")"
+# --sdf before the scene: a path is not a number, so it is the scene, and the band is the default 3 cells.
+"$build/vox-voxelize" --sdf "$cube" -o "$tmp/first.vgrid" --res 8 -q 2>"$tmp/err" || fail "--sdf SCENE: $(cat "$tmp/err")"
+grep -q 'within 3 cell widths' <("$build/vox-info" "$tmp/first.vgrid") || fail "--sdf SCENE: no default band"
+"$build/vox-voxelize" --sdf 2 "$cube" -o "$tmp/first2.vgrid" --res 8 -q 2>"$tmp/err" || fail "--sdf 2 SCENE: $(cat "$tmp/err")"
+grep -q 'within 2 cell widths' <("$build/vox-info" "$tmp/first2.vgrid") || fail "--sdf 2 SCENE: not stored"
+"$build/vox-voxelize" "$cube" -o "$tmp/bad.vgrid" --sdf x --res 8 2>"$tmp/err"  # a scene given: x is a bad HALF
+[ $? = 1 ] && grep -q 'HALF x is not a number' "$tmp/err" && [ ! -e "$tmp/bad.vgrid" ] || fail "SCENE --sdf x: $(cat "$tmp/err")"
+# An inside-out cube: its fractions count the solid it encloses (1), its signed volume is -1; vox-info says why.
+awk '/^f /{print "f", $4, $3, $2; next} {print}' "$tmp/box.obj" >"$tmp/inward.obj"
+"$build/vox-voxelize" "$tmp/inward.obj" -o "$tmp/inward.vgrid" --res 8 --fraction -q 2>"$tmp/err" ||
+  fail "--fraction of an inward box: $(cat "$tmp/err")"
+"$build/vox-info" "$tmp/inward.vgrid" >"$tmp/info"
+grep -q '^fraction_volume: 0.105.*(the scene.s own volume: -0.105.*; its triangles face inward' "$tmp/info" ||
+  fail "vox-info of an inward box: $(grep fraction "$tmp/info")"
+grep -q '"mesh_faces_inward": true' <("$build/vox-info" "$tmp/inward.vgrid" --json) || fail "vox-info --json inward"
+grep -q '"mesh_faces_inward": false' <("$build/vox-info" "$tmp/f.vgrid" --json) || fail "vox-info --json outward"
+
 # A scene with a plane: distances leave it out and say so.
 "$build/vox-voxelize" "$src/data/6837/scenes/scene2_06_plane.txt" -o "$tmp/p.vgrid" --res 8 --sdf 2>"$tmp/err" ||
   fail "plane scene: $(cat "$tmp/err")"

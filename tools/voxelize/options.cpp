@@ -1,5 +1,10 @@
 #include "options.h"
 
+#include <algorithm>
+#include <cstring>
+#include <utility>
+#include <vector>
+
 #include "../common/cli_app.h"
 
 #include "../common/grid_flags.h"
@@ -56,11 +61,52 @@ VoxelizeOptions voxelizeOptions(const Options& opt) {
   return cli::voxelizeOptionsFromFlags(opt.method, opt.grid, opt.resolution, opt.bounds);
 }
 
+namespace {
+
+// "--sdf SCENE -o OUT" and "--sdf 2 SCENE -o OUT": --sdf takes 0 or 1 value, but CLI11 gives it every word that
+// follows up to the next option (the scene's path as HALF, or two values). A word that is neither a number nor an
+// option cannot be HALF: moved before --sdf, it is the positional scene. Used only when the command line so read is
+// valid (parsesQuietly), so that "SCENE --sdf x" keeps its own message ("HALF x is not a number").
+std::vector<char*> sceneBeforeSdf(int argc, char** argv) {
+  std::vector<char*> args(argv, argv + argc);
+  const auto plainWord = [](const char* word) {
+    double number = 0;
+    return word[0] != '\0' && word[0] != '-' && !CLI::detail::lexical_cast(std::string(word), number);
+  };
+  for (size_t i = 1; i + 1 < args.size(); ++i) {
+    if (std::strcmp(args[i], "--") == 0) break;
+    if (std::strcmp(args[i], "--sdf") != 0) continue;
+    const size_t word = plainWord(args[i + 1])
+                            ? i + 1
+                            : (i + 2 < args.size() && args[i + 1][0] != '-' && plainWord(args[i + 2]) ? i + 2 : 0);
+    if (word == 0) continue;
+    std::rotate(args.begin() + ptrdiff_t(i), args.begin() + ptrdiff_t(word), args.begin() + ptrdiff_t(word) + 1);
+    i = word;
+  }
+  return args;
+}
+
+bool parsesQuietly(std::vector<char*> args) {
+  Options scratch;
+  CLI::App app{"", "vox-voxelize"};
+  addOptions(app, scratch);
+  try {
+    app.parse(int(args.size()), args.data());
+    return true;
+  } catch (const CLI::Error&) {
+    return false;
+  }
+}
+
+}  // namespace
+
 std::optional<int> parseCommandLine(int argc, char** argv, Options& opt) {
   CLI::App app{"Voxelize a scene (.txt course format, .obj, .gltf, .glb, .ply) into a sparse grid file (.vgrid).",
                "vox-voxelize"};
   addOptions(app, opt);
-  const std::optional<int> exit = cli::parse(app, argc, argv);
+  std::vector<char*> args = sceneBeforeSdf(argc, argv);
+  if (!std::equal(args.begin(), args.end(), argv) && !parsesQuietly(args)) args.assign(argv, argv + argc);
+  const std::optional<int> exit = cli::parse(app, int(args.size()), args.data());
   opt.fill = opt.fill || opt.fraction;  // a fraction's cells inside are the fill's solid cells (DESIGN.md)
   return exit;
 }

@@ -3,6 +3,7 @@
 #include <cfloat>
 
 #include "vox/core/error.h"
+#include "vox/core/exact_number.h"
 #include "vox/core/material_at.h"
 
 namespace vox {
@@ -86,7 +87,8 @@ void validateScene(const Scene& scene, const std::string& source) {
     const auto& s = scene.spheres[i];
     if (!isFinite(s.center) || !std::isfinite(s.radius))
       fail<InputError>(source, ": sphere ", i, ": centre or radius is NaN or infinite");
-    if (!(s.radius > 0)) fail<InputError>(source, ": sphere ", i, ": radius ", s.radius, " is not positive");
+    if (!(s.radius > 0))
+      fail<InputError>(source, ": sphere ", i, ": radius ", exactNumber(s.radius), " is not positive");
     for (const auto& row : s.transform.m)
       for (double x : row)
         if (!std::isfinite(x)) fail<InputError>(source, ": sphere ", i, ": transform is NaN or infinite");
@@ -119,9 +121,9 @@ void validateCamera(const Camera& c, const std::string& source) {
   if (!(length(cross(normalize(c.direction), c.up)) > 0))
     fail<InputError>(source, ": camera up is zero or parallel to its direction");
   if (c.kind == CameraKind::Perspective && !(c.fovDegrees > 0 && c.fovDegrees < 180))
-    fail<InputError>(source, ": camera field of view ", c.fovDegrees, " is not between 0 and 180 degrees");
+    fail<InputError>(source, ": camera field of view ", exactNumber(c.fovDegrees), " is not between 0 and 180 degrees");
   if (c.kind == CameraKind::Orthographic && !(c.orthoHeight > 0))
-    fail<InputError>(source, ": orthographic camera size ", c.orthoHeight, " is not positive");
+    fail<InputError>(source, ": orthographic camera size ", exactNumber(c.orthoHeight), " is not positive");
 }
 
 Camera defaultCamera(const Box& bounds) {

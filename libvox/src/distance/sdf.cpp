@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "vox/core/error.h"
+#include "vox/core/exact_number.h"
 #include "vox/distance/centre_signs.h"
 #include "vox/voxelize/fill.h"
 
@@ -16,7 +17,8 @@ namespace vox {
 
 void checkSdfHalfWidth(double halfWidth, const char* what) {
   if (!(halfWidth > 0) || !(halfWidth <= kMaxSdfHalfWidth))
-    fail<UsageError>(what, ": half-width ", halfWidth, " must be a number in (0, ", kMaxSdfHalfWidth, "] cell widths");
+    fail<UsageError>(what, ": half-width ", exactNumber(halfWidth), " must be a number in (0, ",
+                     exactNumber(kMaxSdfHalfWidth), "] cell widths");
 }
 
 namespace {
@@ -165,7 +167,7 @@ std::vector<std::vector<Candidate>> bandCandidates(const Grid& grid, const Scene
   });
   if (cancelled) fail<Error>("signed distances cancelled");
   if (overBudget)
-    fail<LimitError>("signed distance band: more than ", maxCells, " cells within ", options.halfWidth,
+    fail<LimitError>("signed distance band: more than ", maxCells, " cells within ", exactNumber(options.halfWidth),
                      " cell widths, over the memory limit of ", options.memoryLimitBytes >> 20,
                      " MiB; use a narrower band or fewer cells");
   return pieces;

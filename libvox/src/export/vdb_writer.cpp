@@ -19,6 +19,7 @@
 #include "export/export_budget.h"
 #include "vox/core/checked_math.h"
 #include "vox/core/error.h"
+#include "vox/core/exact_number.h"
 #include "vox/export/voxel_runs.h"
 #include "vox/core/memory_budget.h"
 
@@ -45,7 +46,7 @@ openvdb::math::Transform::Ptr cellTransform(const Grid& grid) {
           std::make_shared<openvdb::math::ScaleTranslateMap>(scale, translate));
   } catch (const openvdb::Exception&) {
   }
-  fail<LimitError>("vdb: cells of ", scale[0], " x ", scale[1], " x ", scale[2],
+  fail<LimitError>("vdb: cells of ", exactNumber(scale[0]), " x ", exactNumber(scale[1]), " x ", exactNumber(scale[2]),
                    " are beyond OpenVDB's transform (the product of a cell's sides must be a nonzero finite number)");
 }
 

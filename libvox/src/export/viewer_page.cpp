@@ -14,6 +14,7 @@
 #include <zlib.h>
 
 #include "vox/core/error.h"
+#include "vox/core/exact_number.h"
 #include "vox/io/atomic_file.h"
 
 #ifdef VOX_HAVE_VIEWER_SCRIPT
@@ -204,7 +205,7 @@ void checkFields(const Grid& grid) {
   if (grid.sdfKeys.size() != grid.sdfValues.size())
     fail<InputError>("grid: ", grid.sdfKeys.size(), " signed-distance keys but ", grid.sdfValues.size(), " values");
   if (!(grid.sdfHalfWidth >= 0) || (grid.sdfHalfWidth == 0 && !grid.sdfKeys.empty()))
-    fail<InputError>("grid: signed distances with a band half-width of ", grid.sdfHalfWidth, " cells");
+    fail<InputError>("grid: signed distances with a band half-width of ", exactNumber(grid.sdfHalfWidth), " cells");
   for (size_t b = 0; b < grid.sdfKeys.size(); ++b)
     if (grid.sdfKeys[b] >= cells || (b > 0 && grid.sdfKeys[b] <= grid.sdfKeys[b - 1]))
       fail<InputError>("grid: signed-distance keys not ascending inside the grid (key ", grid.sdfKeys[b], ")");

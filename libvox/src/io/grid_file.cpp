@@ -117,8 +117,11 @@ void putSections(ByteWriter& w, const Scene& scene, const Grid& grid) {
   }
 }
 
+// Sections in strictly increasing tag order, as written (docs/grid-format.md "Sections"): a file has one encoding, and
+// a later section's check may rely on an earlier one's content.
 void getSections(ByteReader& r, Scene& scene, Grid& grid) {
   std::vector<bool> seen(sectionCodecs().size(), false);
+  const SectionCodec* previous = nullptr;
   while (!r.atEnd()) {
     const uint32_t tag = r.get<uint32_t>();
     const uint64_t size = r.get<uint64_t>();
@@ -129,7 +132,12 @@ void getSections(ByteReader& r, Scene& scene, Grid& grid) {
       r.corrupt("unknown section tag " + std::to_string(tag) + " (written by a newer libvox?)");
     const SectionCodec& codec = sectionCodecs()[c];
     if (seen[c]) r.corrupt(std::string("repeated ") + codec.name + " section");
+    if (previous && uint32_t(previous->tag) > tag)
+      r.corrupt(std::string(codec.name) + " section (tag " + std::to_string(tag) + ") after the " + previous->name +
+                " section (tag " + std::to_string(uint32_t(previous->tag)) +
+                "): sections must come in increasing tag order");
     seen[c] = true;
+    previous = &codec;
     const size_t start = r.position();
     codec.get(r, scene, grid);
     if (r.position() - start != size) r.corrupt(std::string(codec.name) + " section does not match its size");

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "io/grid_sections.h"
+#include "vox/core/exact_number.h"
 
 namespace vox {
 
@@ -19,7 +20,9 @@ void putDistancesSection(ByteWriter& w, const Scene&, const Grid& grid) {
 
 void getDistancesSection(ByteReader& r, Scene&, Grid& grid) {
   const double halfWidth = r.getFinite("distance band half-width");
-  if (!(halfWidth > 0) || halfWidth > 64) r.corrupt("distance band half-width " + std::to_string(halfWidth));
+  // 64: kMaxSdfHalfWidth (vox/distance/sdf.h), the widest band the writers make.
+  if (!(halfWidth > 0) || halfWidth > 64)
+    r.corrupt("distance band half-width " + exactNumber(halfWidth) + " outside (0, 64] cell edges");
   std::vector<uint64_t> keys = r.getArray<uint64_t>("distance band cell");
   r.need(keys.size() * sizeof(double));
   for (size_t i = 0; i < keys.size(); ++i) {

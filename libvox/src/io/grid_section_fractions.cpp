@@ -5,6 +5,7 @@
 #include <string>
 
 #include "io/grid_sections.h"
+#include "vox/core/exact_number.h"
 
 namespace vox {
 
@@ -18,7 +19,7 @@ void getFractionsSection(ByteReader& r, Scene&, Grid& grid) {
     r.corrupt(std::to_string(fractions.size()) + " volume fractions for " + std::to_string(grid.occupiedCount()) +
               " occupied cells");
   for (double f : fractions)
-    if (!(f >= 0 && f <= 1)) r.corrupt("volume fraction " + std::to_string(f) + " outside [0, 1]");
+    if (!(f >= 0 && f <= 1)) r.corrupt("volume fraction " + exactNumber(f) + " outside [0, 1]");
   grid.fractions = std::move(fractions);
 }
 

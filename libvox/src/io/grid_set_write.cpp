@@ -10,6 +10,7 @@
 #include <system_error>
 
 #include "io/grid_set_header.h"
+#include "vox/core/memory_budget.h"
 #include "vox/io/atomic_file.h"
 #include "vox/io/grid_set.h"
 #include "vox/io/input_file.h"
@@ -186,6 +187,94 @@ BrickEntry writeBrickFile(const std::string& setPath, const GridSetManifest& set
   e.fileChecksum = headerChecksum(bytes);
   writeFileAtomically(besideManifest(setPath, e.file), bytes);
   return e;
+}
+
+void checkGridSetHolds(const Grid& grid, const std::string& what) {
+  const bool sdf = grid.sdfHalfWidth != 0 || !grid.sdfKeys.empty(), fractions = !grid.fractions.empty();
+  if (!sdf && !fractions) return;
+  fail<UsageError>(what, ": a grid set holds no signed distances or volume fractions, and this grid has ",
+                   sdf && fractions ? "both" : (sdf ? "signed distances" : "volume fractions"), ": save it without ",
+                   what, " (a single .vgrid holds them) or voxelize without sdf and fraction");
+}
+
+namespace {
+
+// The cells of one layer of bricks, [c0, c1) of `grid`'s, ordered by brick (bx + BX by) by a counting sort that
+// keeps each brick's keys ascending: brick i holds order[start[i] .. start[i + 1]).
+struct LayerOrder {
+  std::vector<uint64_t> start;
+  std::vector<size_t> order;
+
+  LayerOrder(const Grid& grid, const std::array<uint32_t, 3>& bricks, size_t c0, size_t c1)
+      : start(uint64_t(bricks[0]) * bricks[1] + 1, 0), order(c1 - c0) {
+    auto brickOf = [&](size_t c) {
+      const auto ijk = cellIndex(grid.dims, grid.cellKeys[c]);
+      return brickOfCell(ijk[0], grid.dims[0], bricks[0]) +
+             uint64_t(bricks[0]) * brickOfCell(ijk[1], grid.dims[1], bricks[1]);
+    };
+    for (size_t c = c0; c < c1; ++c) ++start[brickOf(c) + 1];
+    for (size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+    std::vector<uint64_t> next(start.begin(), start.end() - 1);
+    for (size_t c = c0; c < c1; ++c) order[next[brickOf(c)]++] = c;
+  }
+};
+
+// Brick `i` of a layer: its cells (order[start[i] .. start[i + 1])) with their primitive lists, and `runs`.
+Grid brickCells(const Grid& grid, const LayerOrder& layer, uint64_t i, std::vector<CellRun> runs) {
+  Grid b = emptyGridLike(grid);
+  const uint64_t n = layer.start[i + 1] - layer.start[i];
+  b.cellKeys.reserve(n);
+  b.cellStart.reserve(n + 1);
+  for (uint64_t k = layer.start[i]; k < layer.start[i + 1]; ++k) {
+    const size_t c = layer.order[k];
+    b.cellKeys.push_back(grid.cellKeys[c]);
+    const auto prims = grid.cellPrims(c);
+    b.primIds.insert(b.primIds.end(), prims.begin(), prims.end());
+    b.cellStart.push_back(b.primIds.size());
+  }
+  b.solidRuns = std::move(runs);
+  return b;
+}
+
+}  // namespace
+
+GridSetManifest writeGridAsSet(const std::string& setPath, const Scene& scene, const Grid& grid,
+                               const std::array<uint32_t, 3>& bricks, const std::function<bool(double)>& progress) {
+  checkGridSetHolds(grid, "bricks");
+  checkBrickCounts(grid.dims, bricks);
+  checkGridSetOutput(setPath);
+  VOX_CHECK(grid.cellStart.size() == grid.occupiedCount() + 1);
+  const uint64_t plane = uint64_t(grid.dims[0]) * grid.dims[1], perLayer = uint64_t(bricks[0]) * bricks[1];
+  // LayerOrder's counts and order (bricks of a layer by the million, say 2048 x 2048), before any file is touched.
+  checkMemory(double(perLayer) * 16 + double(grid.occupiedCount()) * 8, setPath, "splitting the grid into bricks");
+  auto runs = splitRunsByBrick(grid.solidRuns, grid.dims, bricks);
+  GridSetOutput output(setPath);
+  GridSetManifest m{
+      grid.bounds, grid.dims, grid.method, bricks, writeGridSetScene(setPath, output.folder(), scene, grid), {}};
+  size_t c0 = 0, r = 0;  // the layer's first cell; the next brick of `runs`
+  for (uint32_t bz = 0; bz < bricks[2]; ++bz) {
+    const uint64_t endKey = uint64_t(brickWindow(grid.dims, bricks, {0, 0, bz}).end[2]) * plane;
+    const size_t c1 = size_t(std::lower_bound(grid.cellKeys.begin() + ptrdiff_t(c0), grid.cellKeys.end(), endKey) -
+                             grid.cellKeys.begin());
+    const LayerOrder layer(grid, bricks, c0, c1);
+    c0 = c1;
+    for (uint64_t i = 0; i < perLayer; ++i) {
+      if (progress && !progress((double(bz) + double(i) / double(perLayer)) / double(bricks[2])))
+        fail<Error>("save cancelled");
+      const std::array<uint32_t, 3> index{uint32_t(i % bricks[0]), uint32_t(i / bricks[0]), bz};
+      std::vector<CellRun> brickRuns;
+      if (r < runs.size() && runs[r].first == brickNumber(bricks, index)) brickRuns = std::move(runs[r++].second);
+      if (layer.start[i + 1] == layer.start[i] && brickRuns.empty()) continue;
+      m.entries.push_back(writeBrickFile(setPath, m, index, brickCells(grid, layer, i, std::move(brickRuns))));
+    }
+  }
+  // The set is the grid by construction; its totals are checked all the same, before it replaces anything.
+  uint64_t occupied = 0, references = 0, solid = 0;
+  for (const BrickEntry& e : m.entries) occupied += e.occupied, references += e.references, solid += e.solid;
+  VOX_CHECK(occupied == grid.occupiedCount() && references == grid.referenceCount() && solid == grid.solidCount());
+  if (progress && !progress(1.0)) fail<Error>("save cancelled");
+  output.commit(m);
+  return m;
 }
 
 void writeGridSetManifest(const std::string& setPath, const GridSetManifest& manifest) {

@@ -91,9 +91,12 @@ Summary summarize(const InfoSource& in) {
 
 // The solid's volume as the scene gives it: the triangles' signed volume (divergence theorem: sum of a . (b x c) / 6,
 // positive for outward-oriented closed meshes) plus each sphere's and ellipsoid's 4/3 pi r^3 |det L|.
-double sceneVolume(const Scene& sc) {
+// `meshVolume` gets the triangles' part alone: negative when they face inward (the fill and the fractions go by the
+// winding number's magnitude, so they count what such a mesh encloses as solid).
+double sceneVolume(const Scene& sc, double* meshVolume = nullptr) {
   CompensatedSum v;
   for (const Triangle& t : sc.triangles) v.add(dot(t.v[0], cross(t.v[1], t.v[2])) / 6);
+  if (meshVolume) *meshVolume = v.value();
   for (const Sphere& sp : sc.spheres)
     v.add(4.0 / 3.0 * M_PI * sp.radius * sp.radius * sp.radius * std::fabs(linearDeterminant(sp.transform)));
   return v.value();
@@ -103,6 +106,7 @@ double sceneVolume(const Scene& sc) {
 struct DistanceSummary {
   double bandMin = 0, bandMax = 0;
   double fractionVolume = 0, sceneVolume = 0;
+  double meshVolume = 0;  // the triangles' signed volume: negative when they face inward
 };
 
 DistanceSummary summarizeDistances(const Scene& sc, const Grid& g, uint64_t solidCells) {
@@ -118,7 +122,7 @@ DistanceSummary summarizeDistances(const Scene& sc, const Grid& g, uint64_t soli
     sum.add(double(solidCells));
     for (double f : g.fractions) sum.add(f);
     d.fractionVolume = sum.value() * cell;
-    d.sceneVolume = sceneVolume(sc);
+    d.sceneVolume = sceneVolume(sc, &d.meshVolume);
   }
   return d;
 }
@@ -130,7 +134,11 @@ void plainDistances(std::ostream& out, const InfoSource& in) {
     out << "distance_band: " << g.sdfKeys.size() << " cells within " << num(g.sdfHalfWidth)
         << " cell widths, signed distances " << num(d.bandMin) << " to " << num(d.bandMax) << "\n";
   if (!g.fractions.empty())
-    out << "fraction_volume: " << num(d.fractionVolume) << " (the scene's own volume: " << num(d.sceneVolume) << ")\n";
+    out << "fraction_volume: " << num(d.fractionVolume) << " (the scene's own volume: " << num(d.sceneVolume)
+        << (d.meshVolume < 0 ? "; its triangles face inward (negative signed volume " + num(d.meshVolume) +
+                                   "), and the fractions count the solid they enclose all the same"
+                             : std::string())
+        << ")\n";
 }
 
 void jsonDistances(std::ostream& out, const InfoSource& in) {
@@ -141,7 +149,7 @@ void jsonDistances(std::ostream& out, const InfoSource& in) {
         << ", \"min\": " << num(d.bandMin) << ", \"max\": " << num(d.bandMax) << "},\n";
   if (!g.fractions.empty())
     out << "  \"fractions\": {\"volume\": " << num(d.fractionVolume) << ", \"scene_volume\": " << num(d.sceneVolume)
-        << "},\n";
+        << ", \"mesh_faces_inward\": " << (d.meshVolume < 0 ? "true" : "false") << "},\n";
 }
 
 void plain(std::ostream& out, const InfoSource& in) {

@@ -17,6 +17,7 @@
 #include "voxelize/radix_sort.h"
 #include "voxelize/triangle_filter.h"
 #include "vox/core/error.h"
+#include "vox/core/exact_number.h"
 #include "vox/voxelize/overlap.h"
 
 namespace vox {
@@ -49,8 +50,8 @@ void alignUpperBounds(Grid& grid) {
     while (cellBoundary(grid.bounds, grid.dims, a, grid.dims[a]) != grid.bounds.hi[a]) {
       grid.bounds.hi.at(a) = std::nextafter(grid.bounds.hi[a], HUGE_VAL);
       if (++steps > 4096)
-        fail<E>("bounds [", grid.bounds.lo[a], ", ", grid.bounds.hi[a], "] on axis ", "xyz"[a],
-                " cannot be divided into ", grid.dims[a],
+        fail<E>("bounds [", exactNumber(grid.bounds.lo[a]), ", ", exactNumber(grid.bounds.hi[a]), "] on axis ",
+                "xyz"[a], " cannot be divided into ", grid.dims[a],
                 " cells in double precision (coordinates of very "
                 "different magnitudes?)");
     }
@@ -224,8 +225,8 @@ Grid planGrid(const Scene& scene, const VoxelizeOptions& options) {
     grid.bounds = paddedBounds(*b);
     for (int a = 0; a < 3; ++a)
       if (!std::isfinite(grid.bounds.hi[a] - grid.bounds.lo[a]))
-        fail<InputError>("scene bounds [", grid.bounds.lo[a], ", ", grid.bounds.hi[a], "] on axis ", "xyz"[a],
-                         " are wider than the largest double: no grid can divide them");
+        fail<InputError>("scene bounds [", exactNumber(grid.bounds.lo[a]), ", ", exactNumber(grid.bounds.hi[a]),
+                         "] on axis ", "xyz"[a], " are wider than the largest double: no grid can divide them");
   } else {
     grid.bounds = {{0, 0, 0}, {1, 1, 1}};
     grid.dims = {1, 1, 1};

@@ -120,6 +120,19 @@ GridSetScene writeGridSetScene(const std::string& setPath, const std::string& fo
 BrickEntry writeBrickFile(const std::string& setPath, const GridSetManifest& set, const std::array<uint32_t, 3>& index,
                           const Grid& cells);
 
+// Refuses a grid that a set cannot hold whole: a set's bricks hold cells, primitive lists and solid runs, no signed
+// distances and no volume fractions, which a grid set would drop. Throws UsageError naming `what` (the argument).
+void checkGridSetHolds(const Grid& grid, const std::string& what);
+
+// Writes `grid` and `scene` (the scene it was voxelized from) as a grid set of `bricks`: the grid's own cells,
+// primitive lists and solid runs split at brick faces, not a new voxelization, so the set read back is `grid`, cell
+// for cell and run for run (whatever fill made its solid cells). One layer of bricks (one bz) is ordered at a time,
+// 8 bytes a cell of the layer. Every check is made before the manifest replaces the old output (GridSetOutput), so a
+// refusal, an error or a cancel (`progress`, given the fraction done, returning false: vox::Error) leaves it whole.
+// Throws UsageError (checkGridSetHolds, checkBrickCounts) before any file is touched, OutputError as GridSetOutput.
+GridSetManifest writeGridAsSet(const std::string& setPath, const Scene& scene, const Grid& grid,
+                               const std::array<uint32_t, 3>& bricks, const std::function<bool(double)>& progress = {});
+
 // Writes the manifest (atomically: a failure leaves the old one). Entries without cells are left out. Prefer
 // GridSetOutput::commit, which also removes the replaced set's files.
 void writeGridSetManifest(const std::string& setPath, const GridSetManifest& manifest);

@@ -270,7 +270,8 @@ struct Dispositions {
   bool operator==(const Dispositions& o) const {
     for (size_t i = 0; i < actions.size(); ++i) {
       const struct sigaction &a = actions[i], &b = o.actions[i];
-      if (a.sa_handler != b.sa_handler || a.sa_flags != b.sa_flags) return false;
+      // SA_RESTORER is glibc's own: it sets it on every sigaction(), restoring a never-set default included.
+      if (a.sa_handler != b.sa_handler || (a.sa_flags ^ b.sa_flags) & ~SA_RESTORER) return false;
       for (int sig = 1; sig < NSIG; ++sig)
         if (sigismember(&a.sa_mask, sig) != sigismember(&b.sa_mask, sig)) return false;
     }

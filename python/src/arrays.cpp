@@ -114,8 +114,7 @@ std::vector<vox::Vec3> vec3Array(const py::handle& obj, const char* name, bool a
 std::vector<std::array<uint32_t, 3>> faceArray(const py::handle& obj, const char* name, size_t vertexCount) {
   const py::array a = asArray(obj, name);
   const char kind = kindOf(a);
-  if (kind != 'i' && kind != 'u')
-    failType(name, " must hold integers (vertex indices), not ", dtypeText(a));
+  if (kind != 'i' && kind != 'u') failType(name, " must hold integers (vertex indices), not ", dtypeText(a));
   requireShape(a, name, "(F, 3)", 3);
   if (a.shape(0) == 0) vox::fail<vox::InputError>(name, ": empty array (shape ", shapeText(a), "): no triangles");
   std::vector<std::array<uint32_t, 3>> out(size_t(a.shape(0)));

@@ -13,7 +13,8 @@ namespace {
 // Seconds that voxelizeScene takes over every scene of `sources` ((vertices, faces) pairs, converted before the
 // clock starts) at `resolution`, one after the other, as a C++ program calling the library would.
 double voxelizeLoop(const py::object& sources, const py::object& resolution, const py::object& threads) {
-  if (!py::isinstance<py::list>(sources)) failType("sources must be a list of (vertices, faces) pairs, not ", typeName(sources));
+  if (!py::isinstance<py::list>(sources))
+    failType("sources must be a list of (vertices, faces) pairs, not ", typeName(sources));
   std::vector<vox::Scene> scenes;
   for (const py::handle s : sources) {
     const auto pair = sequenceArg(s, "sources[" + std::to_string(scenes.size()) + "]", 2, "a (vertices, faces) pair");

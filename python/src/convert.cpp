@@ -243,8 +243,8 @@ std::string joined(const std::vector<std::string>& names, size_t from, size_t to
     size_t required = self;
     while (required < s.positional && !s.hasDefault[required]) ++required;
     failType(s.name, "() takes ", required == s.positional ? "" : "at most ", most, " positional argument",
-             most == 1 ? "" : "s", most ? " (" + joined(s.params, self, s.positional) + ")" : "", " but ",
-             given - self, given - self == 1 ? " was" : " were", " given",
+             most == 1 ? "" : "s", most ? " (" + joined(s.params, self, s.positional) + ")" : "", " but ", given - self,
+             given - self == 1 ? " was" : " were", " given",
              s.positional < n ? "; " + joined(s.params, s.positional, n) + " are keyword-only (name=value)" : "");
   }
   std::vector<py::handle> bound(n);
@@ -253,8 +253,7 @@ std::string joined(const std::vector<std::string>& names, size_t from, size_t to
     const std::string name = py::str(key);
     const auto at = std::find(s.params.begin() + std::ptrdiff_t(self), s.params.end(), name);
     if (at == s.params.end())
-      failType(s.name, "() got an unexpected keyword argument '", name, "' (it takes ", joined(s.params, self, n),
-               ")");
+      failType(s.name, "() got an unexpected keyword argument '", name, "' (it takes ", joined(s.params, self, n), ")");
     const size_t i = size_t(at - s.params.begin());
     if (i < given) failType(s.name, "() got multiple values for argument '", name, "'");
     if (i < s.positionalOnly) failType(s.name, "(): ", name, " is positional-only and cannot be given by name");
@@ -268,8 +267,10 @@ std::string joined(const std::vector<std::string>& names, size_t from, size_t to
   failType(s.name, "(): these arguments do not fit its signature (", joined(s.params, self, n), ")");
 }
 
+}  // namespace
+
 // The pybind11 record of a bound function, or null for anything else.
-py::detail::function_record* recordOf(const py::handle& function) {
+py::detail::function_record* functionRecord(const py::handle& function) {
   if (!function || !PyCFunction_Check(function.ptr())) return nullptr;
   const py::handle self = PyCFunction_GET_SELF(function.ptr());
   if (!self || !py::isinstance<py::capsule>(self)) return nullptr;
@@ -278,15 +279,13 @@ py::detail::function_record* recordOf(const py::handle& function) {
   return capsule.get_pointer<py::detail::function_record>();
 }
 
-}  // namespace
-
 void nameBadCalls(py::handle scope, py::handle grid) {
   const bool isClass = PyType_Check(scope.ptr());
   const std::string prefix = isClass ? py::str(scope.attr("__name__")).cast<std::string>() + "." : "";
   const py::dict members(scope.attr("__dict__"));  // a copy: the loop adds to the scope's functions
   for (const auto& [key, value] : members) {
     const py::handle function = py::detail::get_function(value);  // a method's function
-    py::detail::function_record* rec = recordOf(function);
+    py::detail::function_record* rec = functionRecord(function);
     if (!rec || rec->next || rec->is_constructor || rec->is_operator || rec->has_args || rec->has_kwargs) continue;
     const std::optional<Signature> signature = signatureOf(*rec, prefix, grid);
     if (!signature) continue;

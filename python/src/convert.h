@@ -109,5 +109,8 @@ std::optional<int> threadsArg(const py::handle& threads);
 // pybind11's "incompatible function arguments" and its list of C++ signatures. `grid`: the Grid class. Call once
 // all are defined.
 void nameBadCalls(py::handle scope, py::handle grid);
+// The pybind11 record of a bound function (a module's function, or a method's as the class gives it), or null for
+// anything else.
+py::detail::function_record* functionRecord(const py::handle& function);
 
 }  // namespace voxpy

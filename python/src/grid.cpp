@@ -215,8 +215,9 @@ std::shared_ptr<PyGrid> fromState(const py::handle& state) {
 // libvox._unpickle_grid), so setting a state is refused, the grid left as it was, instead of pybind11's silent
 // no-op on an initialised instance.
 void setStateRefused(const PyGrid&, const py::handle&) {
-  failType("libvox.Grid.__setstate__: this Grid is already initialised and grids are read-only; pickle.loads "
-           "makes a new Grid from a state");
+  failType(
+      "libvox.Grid.__setstate__: this Grid is already initialised and grids are read-only; pickle.loads "
+      "makes a new Grid from a state");
 }
 
 }  // namespace
@@ -226,15 +227,17 @@ void checkInitialised(const py::handle& obj) {
   if (!info || !PyObject_TypeCheck(obj.ptr(), info->type)) return;
   auto* instance = reinterpret_cast<py::detail::instance*>(obj.ptr());
   if (!instance->get_value_and_holder(info).holder_constructed())
-    failType("libvox.Grid: this object was made by __new__ alone and holds no grid; grids come from "
-             "libvox.voxelize, libvox.voxelize_batch, libvox.load and pickle.loads");
+    failType(
+        "libvox.Grid: this object was made by __new__ alone and holds no grid; grids come from "
+        "libvox.voxelize, libvox.voxelize_batch, libvox.load and pickle.loads");
 }
 
 namespace {
 
 py::object refuseNew(const py::handle&, const py::args&, const py::kwargs&) {
-  failType("libvox.Grid cannot be made directly: grids come from libvox.voxelize, libvox.voxelize_batch, "
-           "libvox.load and pickle.loads");
+  failType(
+      "libvox.Grid cannot be made directly: grids come from libvox.voxelize, libvox.voxelize_batch, "
+      "libvox.load and pickle.loads");
 }
 
 }  // namespace
@@ -352,6 +355,9 @@ on a boundary between cells counts for both; points outside the bounds are False
       .def("__reduce__", [](const PyGrid& self) {
         return py::make_tuple(py::module_::import("libvox").attr("_unpickle_grid"), py::make_tuple(getState(self)));
       });
+  // pybind11 2.10 takes every method named __setstate__ for a constructor, which its dispatcher skips without a word
+  // on an initialised instance (issue 45: it did nothing and raised nothing): this one is a plain method.
+  functionRecord(py::detail::get_function(grid.attr("__setstate__")))->is_constructor = false;
   m.def("_grid_from_state", &fromState, py::arg("state"),
         "The Grid of a pickle state (libvox._unpickle_grid calls it): InputError for corrupt bytes, TypeError for a "
         "state that is not (bytes, str).");

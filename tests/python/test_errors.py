@@ -183,7 +183,7 @@ def test_none_is_named_as_none():
                                         r"NoneType$"):
         grid.distance(None)
     with pytest.raises(TypeError, match=r"not a list of other objects$"):
-        grid.distance([["a", "b", "c"]])
+        grid.distance([[None, None, None]])
     with pytest.raises(TypeError, match=r"not dtype object$"):
         grid.distance(np.array([[1, 2, 3]], dtype=object))
 

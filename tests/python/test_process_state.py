@@ -135,7 +135,8 @@ STATE = PRELUDE + textwrap.dedent("""
     def c_disposition(sig):
         action = ctypes.create_string_buffer(256)  # struct sigaction, with room to spare
         assert libc.sigaction(sig, None, action) == 0
-        return action.raw[:8] + action.raw[8 + 128:8 + 128 + 4]  # the handler and the flags
+        flags = int.from_bytes(action.raw[8 + 128:8 + 128 + 4], "little") & ~0x04000000  # SA_RESTORER: glibc's own
+        return action.raw[:8].hex(), hex(flags)  # the handler and the flags
 
     def fp_state():
         state = [libc.fegetround(), libc.fegetexcept()]

@@ -83,7 +83,7 @@ extern "C" void removeTemporariesAndExit(int signal) {
 //    the old output whole. Replacing it with one that _exits would kill an interpreter on Ctrl-C.
 constexpr std::array<int, 3> kSignals{SIGINT, SIGTERM, SIGHUP};
 std::mutex gHandlersMutex;
-int gRegistered = 0;                                    // temporary files and folders registered (gHandlersMutex)
+int gRegistered = 0;                                      // temporary files and folders registered (gHandlersMutex)
 std::array<struct sigaction, kSignals.size()> gPrevious;  // what each replaced disposition was
 std::array<bool, kSignals.size()> gReplaced{};
 bool gXfszIgnored = false;

@@ -270,8 +270,9 @@ struct Dispositions {
   bool operator==(const Dispositions& o) const {
     for (size_t i = 0; i < actions.size(); ++i) {
       const struct sigaction &a = actions[i], &b = o.actions[i];
-      // SA_RESTORER is glibc's own: it sets it on every sigaction(), restoring a never-set default included.
-      if (a.sa_handler != b.sa_handler || (a.sa_flags ^ b.sa_flags) & ~SA_RESTORER) return false;
+      // SA_RESTORER (0x04000000, Linux's <asm/signal.h>; glibc does not export it) is glibc's own: it sets it on
+      // every sigaction(), restoring a never-set default included.
+      if (a.sa_handler != b.sa_handler || (a.sa_flags ^ b.sa_flags) & ~0x04000000) return false;
       for (int sig = 1; sig < NSIG; ++sig)
         if (sigismember(&a.sa_mask, sig) != sigismember(&b.sa_mask, sig)) return false;
     }

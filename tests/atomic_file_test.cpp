@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <csignal>
 #include <fstream>
@@ -252,6 +253,130 @@ TEST(AtomicFile, IgnoredSignalStaysIgnored) {
   });
   EXPECT_EQ(code, 0);
   EXPECT_EQ(readAll(path), "done");
+}
+
+// The dispositions of the signals the writes handle, compared whole (handler, flags, mask).
+struct Dispositions {
+  std::vector<struct sigaction> actions;
+  static Dispositions now() {
+    Dispositions d;
+    for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGXFSZ}) {
+      struct sigaction a {};
+      ::sigaction(sig, nullptr, &a);
+      d.actions.push_back(a);
+    }
+    return d;
+  }
+  bool operator==(const Dispositions& o) const {
+    for (size_t i = 0; i < actions.size(); ++i) {
+      const struct sigaction &a = actions[i], &b = o.actions[i];
+      // SA_RESTORER (0x04000000, Linux's <asm/signal.h>; glibc does not export it) is glibc's own: it sets it on
+      // every sigaction(), restoring a never-set default included.
+      if (a.sa_handler != b.sa_handler || (a.sa_flags ^ b.sa_flags) & ~0x04000000) return false;
+      for (int sig = 1; sig < NSIG; ++sig)
+        if (sigismember(&a.sa_mask, sig) != sigismember(&b.sa_mask, sig)) return false;
+    }
+    return true;
+  }
+};
+
+void (*handlerOf(int sig))(int) {
+  struct sigaction a {};
+  ::sigaction(sig, nullptr, &a);
+  return a.sa_handler;
+}
+
+std::atomic<int> hostSignals{0};
+extern "C" void hostHandler(int) { hostSignals.fetch_add(1); }
+
+// A library leaves the process as it found it (issue 45): after an OutputFile (committed or abandoned),
+// writeFileAtomically and a TemporaryFolder, every disposition is what it was, whether default, ignored or the
+// host's; during a write the default ones are replaced and the others are not.
+TEST(AtomicFile, SignalDispositionsAreRestoredAfterEveryWrite) {
+  testing::ScratchDir dir("atomic_dispositions");
+  const std::string path = dir.file("out.bin"), folder = dir.file("gen");
+  const int code = inChild([&] {
+    struct sigaction host {};
+    host.sa_handler = hostHandler;
+    host.sa_flags = SA_RESTART;
+    sigemptyset(&host.sa_mask);
+    sigaddset(&host.sa_mask, SIGUSR1);
+    // Each setting: SIGINT default, the host's, ignored; SIGTERM/SIGHUP/SIGXFSZ default, then others.
+    for (int setting = 0; setting < 3; ++setting) {
+      if (setting == 1) ::sigaction(SIGINT, &host, nullptr), ::sigaction(SIGHUP, &host, nullptr);
+      if (setting == 2) std::signal(SIGINT, SIG_IGN), std::signal(SIGXFSZ, SIG_IGN);
+      const Dispositions before = Dispositions::now();
+      {
+        OutputFile out(path);
+        // During the write: a default disposition is replaced, the host's and an ignored one are not.
+        if ((handlerOf(SIGTERM) == SIG_DFL) || handlerOf(SIGXFSZ) != SIG_IGN) return 10 + setting;
+        if (setting == 1 && (handlerOf(SIGINT) != hostHandler || handlerOf(SIGHUP) != hostHandler)) return 20;
+        if (setting == 2 && handlerOf(SIGINT) != SIG_IGN) return 21;
+        {
+          OutputFile second(path + "2");  // nested writes: restored only when the last one ends
+          second.write("b");
+          second.commit();
+        }
+        if (handlerOf(SIGTERM) == SIG_DFL) return 22;
+        out.write("a");
+        out.commit();
+      }
+      if (!(Dispositions::now() == before)) return 30 + setting;
+      { OutputFile abandoned(path); }
+      if (!(Dispositions::now() == before)) return 40 + setting;
+      writeFileAtomically(path, "c");
+      if (!(Dispositions::now() == before)) return 50 + setting;
+      {
+        TemporaryFolder f(folder, true);
+        if (handlerOf(SIGTERM) == SIG_DFL) return 60 + setting;
+        writeFileAtomically(folder + "/x", "x");
+        f.keep();
+        if (!(Dispositions::now() == before)) return 70 + setting;
+      }
+      std::filesystem::remove_all(folder);
+      { TemporaryFolder removed(folder, true); }
+      if (!(Dispositions::now() == before)) return 80 + setting;
+    }
+    return 0;
+  });
+  EXPECT_EQ(code, 0);
+}
+
+// Writes on several threads at once: the handlers stay while any is under way and go with the last.
+TEST(AtomicFile, SignalDispositionsAreRestoredAfterConcurrentWrites) {
+  testing::ScratchDir dir("atomic_dispositions_threads");
+  const int code = inChild([&] {
+    const Dispositions before = Dispositions::now();
+    std::vector<std::thread> threads;
+    for (int t = 0; t < 4; ++t)
+      threads.emplace_back([&, t] {
+        for (int n = 0; n < 200; ++n) writeFileAtomically(dir.file("t" + std::to_string(t)), "x");
+      });
+    for (auto& t : threads) t.join();
+    return Dispositions::now() == before ? 0 : 1;
+  });
+  EXPECT_EQ(code, 0);
+}
+
+// A host's handler (Python's SIGINT) runs during a write instead of one that ends the process: the host decides,
+// and a write it abandons keeps the old output and leaves no temporary.
+TEST(AtomicFile, HostHandlerKeepsWorkingDuringAWrite) {
+  testing::ScratchDir dir("atomic_host");
+  const std::string path = dir.file("out.bin");
+  writePlain(path, "old");
+  const int code = inChild([&] {
+    std::signal(SIGINT, hostHandler);
+    {
+      OutputFile out(path);
+      out.write("partial");
+      ::raise(SIGINT);
+      if (hostSignals.load() != 1) return 2;
+    }  // abandoned, as an exception raised by the host's handler would abandon it
+    return handlerOf(SIGINT) == hostHandler ? 0 : 3;
+  });
+  EXPECT_EQ(code, 0);
+  EXPECT_EQ(readAll(path), "old");
+  EXPECT_TRUE(temporaries(dir.path()).empty());
 }
 
 TEST(AtomicFile, OutputThatIsAnInputIsRefused) {

@@ -27,6 +27,18 @@ from ._libvox import (
     voxelize_batch,
 )
 
+
+
+def _unpickle_grid(state):
+    """The Grid of a pickle: Grid.__reduce__ names this function with the state (bytes of the grid file, source).
+
+    A Python function, so that every pickle protocol finds it by name (pybind11's functions have no importable
+    name); Grid.__new__ refuses, so no pickle stream can leave a Grid without its grid.
+    """
+    from . import _libvox
+    return _libvox._grid_from_state(state)
+
+
 __all__ = [
     "Grid",
     "InputError",

@@ -19,6 +19,9 @@ std::string shapeText(const py::array& a) {
   return out.str();
 }
 
+// "dtype float16", "dtype object": a dtype as messages name it (a bare "object" reads as a type).
+std::string dtypeText(const py::array& a) { return "dtype " + std::string(py::str(a.dtype())); }
+
 // The dtype's kind ('f', 'i', 'u', 'b', ...) and size.
 char kindOf(const py::array& a) { return a.dtype().kind(); }
 
@@ -31,7 +34,7 @@ void requireShape(const py::array& a, const char* name, const char* expected, py
 void requireNumeric(const py::array& a, const char* name) {
   const char kind = kindOf(a);
   if ((kind == 'f' && a.dtype().itemsize() <= 8) || kind == 'i' || kind == 'u') return;
-  failType(name, " must hold floats (float32 or float64) or integers, not ", std::string(py::str(a.dtype())));
+  failType(name, " must hold floats (float32 or float64) or integers, not ", dtypeText(a));
 }
 
 // Coordinates as a C-contiguous float64 array, converted exactly: floats up to 64 bits widen exactly, 64-bit
@@ -64,7 +67,7 @@ py::array_t<double> exactDoubles(const py::array& a, const char* name) {
     }
     return py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
   }
-  failType(name, " must hold floats (float32 or float64) or integers, not ", std::string(py::str(a.dtype())));
+  failType(name, " must hold floats (float32 or float64) or integers, not ", dtypeText(a));
 }
 
 }  // namespace
@@ -74,7 +77,15 @@ py::array asArray(const py::handle& obj, const char* name) {
   if (py::isinstance<py::str>(obj) || py::isinstance<py::bytes>(obj))
     failType(name, " must be an array or a sequence of numbers, not ", typeName(obj));
   try {
-    return py::module_::import("numpy").attr("asarray")(obj);
+    const py::array a = py::module_::import("numpy").attr("asarray")(obj);
+    // numpy wraps anything else (None, a dict, a list of str) in an array of objects, whose dtype name "object"
+    // would be all a message could say about it.
+    if (kindOf(a) == 'O' && !isSequence(obj))
+      failType(name, " must be an array of numbers (or a sequence of them), not ", typeName(obj));
+    if (kindOf(a) == 'O')
+      failType(name, " must be an array of numbers (or a sequence of them), not a ", typeName(obj),
+               " of other objects");
+    return a;
   } catch (py::error_already_set& e) {
     if (!e.matches(PyExc_ValueError)) throw;
     vox::fail<vox::InputError>(
@@ -103,8 +114,7 @@ std::vector<vox::Vec3> vec3Array(const py::handle& obj, const char* name, bool a
 std::vector<std::array<uint32_t, 3>> faceArray(const py::handle& obj, const char* name, size_t vertexCount) {
   const py::array a = asArray(obj, name);
   const char kind = kindOf(a);
-  if (kind != 'i' && kind != 'u')
-    failType(name, " must hold integers (vertex indices), not ", std::string(py::str(a.dtype())));
+  if (kind != 'i' && kind != 'u') failType(name, " must hold integers (vertex indices), not ", dtypeText(a));
   requireShape(a, name, "(F, 3)", 3);
   if (a.shape(0) == 0) vox::fail<vox::InputError>(name, ": empty array (shape ", shapeText(a), "): no triangles");
   std::vector<std::array<uint32_t, 3>> out(size_t(a.shape(0)));

@@ -12,14 +12,16 @@ namespace {
 
 // Seconds that voxelizeScene takes over every scene of `sources` ((vertices, faces) pairs, converted before the
 // clock starts) at `resolution`, one after the other, as a C++ program calling the library would.
-double voxelizeLoop(const py::list& sources, uint32_t resolution, const py::object& threads) {
+double voxelizeLoop(const py::object& sources, const py::object& resolution, const py::object& threads) {
+  if (!py::isinstance<py::list>(sources))
+    failType("sources must be a list of (vertices, faces) pairs, not ", typeName(sources));
   std::vector<vox::Scene> scenes;
   for (const py::handle s : sources) {
-    const py::sequence pair = py::reinterpret_borrow<py::sequence>(s);
+    const auto pair = sequenceArg(s, "sources[" + std::to_string(scenes.size()) + "]", 2, "a (vertices, faces) pair");
     scenes.push_back(sceneFromArrays(pair[0], pair[1]));
   }
   vox::VoxelizeOptions vo;
-  vo.resolution = resolution;
+  vo.resolution = uint32_t(intArg(resolution, "resolution", 1, vox::kMaxCellsPerAxis));
   vo.memoryLimitBytes = memoryBudget();
   Interrupt interrupt;
   return runLong(interrupt, threadsArg(threads), [&] {

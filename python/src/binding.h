@@ -75,6 +75,27 @@ class PyGrid {
   BuiltOnce<vox::InsideTest> insideTest_;
 };
 
+// TypeError unless `obj`, when it is a libvox.Grid, has its C++ object: one made by pybind11's base __new__ (which
+// bypasses Grid.__new__'s refusal) has none, and pybind11 would hand the binding uninitialised memory as a PyGrid.
+void checkInitialised(const py::handle& obj);
+
+}  // namespace voxpy
+
+// Every Grid argument and `self` of the binding is loaded through here (type_caster<PyGrid>), so no call can reach
+// a Grid without its C++ object (issue 45: .dims, pickle.dumps and repr read garbage).
+namespace pybind11::detail {
+template <>
+class type_caster<voxpy::PyGrid> : public type_caster_base<voxpy::PyGrid> {
+ public:
+  bool load(handle src, bool convert) {
+    voxpy::checkInitialised(src);
+    return type_caster_base<voxpy::PyGrid>::load(src, convert);
+  }
+};
+}  // namespace pybind11::detail
+
+namespace voxpy {
+
 // ---- Long calls (call.cpp) ----
 
 // Lets a long library call, run with the GIL released, notice Ctrl-C and report progress. The library calls

@@ -3,7 +3,9 @@
 
 #include <pybind11/numpy.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 
 #include "vox/core/error.h"
@@ -177,6 +179,130 @@ vox::Box boxArg(const py::handle& obj, const std::string& name) {
 std::optional<int> threadsArg(const py::handle& threads) {
   if (threads.is_none()) return std::nullopt;
   return int(intArg(threads, "threads", 1, 4096));
+}
+
+// ---- Calls that do not fit a signature ----
+
+namespace {
+
+// What a bound function takes, read from its pybind11 record: the names pybind11 shows, which can be given by
+// position, which have defaults, which must be Grids.
+struct Signature {
+  std::string name;  // "sdf", "Grid.save"
+  bool method = false;
+  std::vector<std::string> params;  // self first for a method
+  std::vector<bool> hasDefault, isGrid;
+  size_t positional = 0, positionalOnly = 0;
+  py::object gridType;
+};
+
+// The parameters of `rec`, or nullopt when one is of a type that pybind11 converts (an int, a list): such a function
+// keeps pybind11's own handling, since the overload added here would also catch its first, conversion-free pass.
+std::optional<Signature> signatureOf(const py::detail::function_record& rec, const std::string& prefix,
+                                     const py::handle& grid) {
+  Signature s;
+  s.name = prefix + rec.name;
+  s.method = rec.is_method;
+  s.positional = rec.nargs_pos;
+  s.positionalOnly = rec.nargs_pos_only;
+  s.gridType = py::reinterpret_borrow<py::object>(grid);
+  const std::string gridName = py::str(grid.attr("__module__")).cast<std::string>() + "." +
+                               py::str(grid.attr("__qualname__")).cast<std::string>();
+  const std::string signature = rec.signature;
+  size_t at = 0;
+  for (size_t i = 0; i < rec.nargs; ++i) {
+    std::string name = i < rec.args.size() && rec.args[i].name ? rec.args[i].name
+                       : i == 0 && rec.is_method               ? "self"
+                                                               : "arg" + std::to_string(i - size_t(rec.is_method));
+    // pybind11 writes "name: type" or "name: type = default", in order.
+    at = signature.find(name + ": ", at);
+    if (at == std::string::npos) return std::nullopt;
+    at += name.size() + 2;
+    const std::string type = signature.substr(at, signature.find_first_of(",)= ", at) - at);
+    if (type != "object" && type != "handle" && type != gridName) return std::nullopt;
+    s.params.push_back(name);
+    s.hasDefault.push_back(i < rec.args.size() && rec.args[i].value);
+    s.isGrid.push_back(type == gridName);
+  }
+  return s;
+}
+
+std::string joined(const std::vector<std::string>& names, size_t from, size_t to) {
+  std::string out;
+  for (size_t i = from; i < to; ++i) out += (i > from ? ", " : "") + names[i];
+  return out;
+}
+
+// Python's messages for a call that does not bind, each naming the argument.
+[[noreturn]] void badCall(const Signature& s, const py::args& args, const py::kwargs& kwargs) {
+  const size_t given = args.size(), self = s.method ? 1 : 0, n = s.params.size();
+  if (s.method && (given == 0 || !py::isinstance(args[0], s.gridType)))
+    failType(s.name, "() needs a libvox.Grid to work on, not ", given == 0 ? "nothing" : typeName(args[0]));
+  if (given > s.positional) {
+    const size_t most = s.positional - self;
+    size_t required = self;
+    while (required < s.positional && !s.hasDefault[required]) ++required;
+    failType(s.name, "() takes ", required == s.positional ? "" : "at most ", most, " positional argument",
+             most == 1 ? "" : "s", most ? " (" + joined(s.params, self, s.positional) + ")" : "", " but ", given - self,
+             given - self == 1 ? " was" : " were", " given",
+             s.positional < n ? "; " + joined(s.params, s.positional, n) + " are keyword-only (name=value)" : "");
+  }
+  std::vector<py::handle> bound(n);
+  for (size_t i = 0; i < given; ++i) bound[i] = args[i];
+  for (const auto& [key, value] : kwargs) {
+    const std::string name = py::str(key);
+    const auto at = std::find(s.params.begin() + std::ptrdiff_t(self), s.params.end(), name);
+    if (at == s.params.end())
+      failType(s.name, "() got an unexpected keyword argument '", name, "' (it takes ", joined(s.params, self, n), ")");
+    const size_t i = size_t(at - s.params.begin());
+    if (i < given) failType(s.name, "() got multiple values for argument '", name, "'");
+    if (i < s.positionalOnly) failType(s.name, "(): ", name, " is positional-only and cannot be given by name");
+    bound[i] = value;
+  }
+  for (size_t i = self; i < n; ++i) {
+    if (!bound[i] && !s.hasDefault[i]) failType(s.name, "() missing required argument '", s.params[i], "'");
+    if (bound[i] && s.isGrid[i] && !py::isinstance(bound[i], s.gridType))
+      failType(s.name, "(): ", s.params[i], " must be a libvox.Grid, not ", typeName(bound[i]));
+  }
+  failType(s.name, "(): these arguments do not fit its signature (", joined(s.params, self, n), ")");
+}
+
+}  // namespace
+
+// The pybind11 record of a bound function, or null for anything else.
+py::detail::function_record* functionRecord(const py::handle& function) {
+  if (!function || !PyCFunction_Check(function.ptr())) return nullptr;
+  const py::handle self = PyCFunction_GET_SELF(function.ptr());
+  if (!self || !py::isinstance<py::capsule>(self)) return nullptr;
+  const auto capsule = py::reinterpret_borrow<py::capsule>(self);
+  if (!py::detail::is_function_record_capsule(capsule)) return nullptr;
+  return capsule.get_pointer<py::detail::function_record>();
+}
+
+void nameBadCalls(py::handle scope, py::handle grid) {
+  const bool isClass = PyType_Check(scope.ptr());
+  const std::string prefix = isClass ? py::str(scope.attr("__name__")).cast<std::string>() + "." : "";
+  const py::dict members(scope.attr("__dict__"));  // a copy: the loop adds to the scope's functions
+  for (const auto& [key, value] : members) {
+    const py::handle function = py::detail::get_function(value);  // a method's function
+    py::detail::function_record* rec = functionRecord(function);
+    if (!rec || rec->next || rec->is_constructor || rec->is_operator || rec->has_args || rec->has_kwargs) continue;
+    const std::optional<Signature> signature = signatureOf(*rec, prefix, grid);
+    if (!signature) continue;
+    // The overload joins the function's chain (py::sibling), which rewrites its docstring as "Overloaded
+    // function..."; the one-overload docstring, whose first line is the signature, is put back.
+    const std::string doc = py::str(function.attr("__doc__"));
+    auto fallback = [s = *signature](const py::args& args, const py::kwargs& kwargs) -> py::object {
+      badCall(s, args, kwargs);
+    };
+    if (isClass)
+      py::cpp_function(fallback, py::name(rec->name), py::is_method(scope), py::sibling(function));
+    else
+      py::cpp_function(fallback, py::name(rec->name), py::scope(scope), py::sibling(function));
+    PyMethodDef* def = reinterpret_cast<PyCFunctionObject*>(function.ptr())->m_ml;
+    std::free(const_cast<char*>(def->ml_doc));  // pybind11's strdup
+    def->ml_doc = strdup(doc.c_str());
+  }
 }
 
 }  // namespace voxpy

@@ -100,4 +100,17 @@ vox::Box boxArg(const py::handle& obj, const std::string& name);
 // The worker threads of a call: nullopt for None, else 1..4096 (as intArg).
 std::optional<int> threadsArg(const py::handle& threads);
 
+// ---- Calls that do not fit a signature ----
+
+// Gives every function of `scope` (the module, or the Grid class for its methods) whose parameters are all objects
+// or Grids a last overload, reached only when a call does not fit the signature (an unknown keyword, one positional
+// argument too many, a missing or repeated one, a Grid argument that is not a Grid): it raises TypeError naming that
+// argument, as Python does for its own functions ("sdf() got an unexpected keyword argument 'method'"), in place of
+// pybind11's "incompatible function arguments" and its list of C++ signatures. `grid`: the Grid class. Call once
+// all are defined.
+void nameBadCalls(py::handle scope, py::handle grid);
+// The pybind11 record of a bound function (a module's function, or a method's as the class gives it), or null for
+// anything else.
+py::detail::function_record* functionRecord(const py::handle& function);
+
 }  // namespace voxpy

@@ -190,17 +190,18 @@ py::object getState(const PyGrid& self) {
   return py::make_tuple(py::bytes(bytes), sourceText(self));
 }
 
-// Grid.__setstate__: decodes the bytes with every check libvox.load makes (counts, offsets, ids, checksum), so a
-// truncated or corrupt pickle raises InputError; a state that is not (bytes, str) raises TypeError.
-std::shared_ptr<PyGrid> setState(const py::object& state) {
-  if (!py::isinstance<py::tuple>(state) || py::len(state) != 2 || !py::isinstance<py::bytes>(state[py::int_(0)]) ||
-      !py::isinstance<py::str>(state[py::int_(1)]))
-    throw py::type_error(
-        "libvox.Grid.__setstate__: the state must be a tuple (bytes of a grid file, source str), "
-        "got " +
-        typeName(state));
-  std::string bytes = state[py::int_(0)].cast<std::string>();
-  const py::object sourceObj = state[py::int_(1)];
+// A Grid from the state of a pickle (libvox._unpickle_grid, the reconstructor Grid.__reduce__ names): decodes the
+// bytes with every check libvox.load makes (counts, offsets, ids, checksum), so a truncated or corrupt pickle raises
+// InputError; a state that is not (bytes, str) raises TypeError saying which part is wrong.
+std::shared_ptr<PyGrid> fromState(const py::handle& state) {
+  constexpr const char* kWhat = "pickled libvox.Grid: the state must be (grid file bytes, source str)";
+  if (!py::isinstance<py::tuple>(state)) failType(kWhat, ", not ", typeName(state));
+  const auto items = py::reinterpret_borrow<py::tuple>(state);
+  if (items.size() != 2) failType(kWhat, ", got a tuple of ", items.size(), " items");
+  if (!py::isinstance<py::bytes>(items[0])) failType(kWhat, ": its first item is ", typeName(items[0]), ", not bytes");
+  if (!py::isinstance<py::str>(items[1])) failType(kWhat, ": its second item is ", typeName(items[1]), ", not str");
+  const std::string bytes = items[0].cast<std::string>();
+  const py::object sourceObj = items[1];
   const std::string source = sourceObj.equal(py::str("<arrays>")) ? "<arrays>" : pathArg(sourceObj, "source");
   vox::GridFile file;
   {
@@ -208,6 +209,35 @@ std::shared_ptr<PyGrid> setState(const py::object& state) {
     file = vox::decodeGridFile(bytes, "pickled grid (" + source + ")");
   }
   return std::make_shared<PyGrid>(std::move(file), source);
+}
+
+// Grid.__setstate__: a Grid is read-only and complete from the moment it exists (unpickling makes a new one through
+// libvox._unpickle_grid), so setting a state is refused, the grid left as it was, instead of pybind11's silent
+// no-op on an initialised instance.
+void setStateRefused(const PyGrid&, const py::handle&) {
+  failType(
+      "libvox.Grid.__setstate__: this Grid is already initialised and grids are read-only; pickle.loads "
+      "makes a new Grid from a state");
+}
+
+}  // namespace
+
+void checkInitialised(const py::handle& obj) {
+  const py::detail::type_info* info = py::detail::get_type_info(typeid(PyGrid));
+  if (!info || !PyObject_TypeCheck(obj.ptr(), info->type)) return;
+  auto* instance = reinterpret_cast<py::detail::instance*>(obj.ptr());
+  if (!instance->get_value_and_holder(info).holder_constructed())
+    failType(
+        "libvox.Grid: this object was made by __new__ alone and holds no grid; grids come from "
+        "libvox.voxelize, libvox.voxelize_batch, libvox.load and pickle.loads");
+}
+
+namespace {
+
+py::object refuseNew(const py::handle&, const py::args&, const py::kwargs&) {
+  failType(
+      "libvox.Grid cannot be made directly: grids come from libvox.voxelize, libvox.voxelize_batch, "
+      "libvox.load and pickle.loads");
 }
 
 }  // namespace
@@ -314,14 +344,23 @@ on a boundary between cells counts for both; points outside the bounds are False
       .def_property_readonly("source", &sourceText,
                              "Where the grid came from: a file path (as os.fsdecode gives it), or '<arrays>'.")
       .def("__repr__", &repr)
-      .def(py::pickle(&getState, &setState))
-      // What pickle calls (every protocol, and copy.copy / copy.deepcopy): made as protocol 2 makes it, so that
-      // protocols 0 and 1 too go through Grid.__new__ and __setstate__ (their default, copyreg._reconstructor,
-      // cannot make a pybind11 object and aborts the interpreter).
-      .def("__reduce__", [](const py::object& self) {
-        return py::make_tuple(py::module_::import("copyreg").attr("__newobj__"), py::make_tuple(py::type::of(self)),
-                              getState(self.cast<const PyGrid&>()));
+      // Grid.__new__ refuses: an instance without its C++ object (what Grid.__new__(Grid) or a pickle stream that
+      // stops after it made) must not exist. Pickles (every protocol, copy.copy, copy.deepcopy) call
+      // libvox._unpickle_grid(state) instead, which makes the Grid whole or raises.
+      .def_static("__new__", &refuseNew)
+      .def("__getstate__", &getState,
+           "The pickle state: (bytes of the grid file, as Grid.save writes a .vgrid; source).")
+      .def("__setstate__", &setStateRefused, py::arg("state"),
+           "Refused with TypeError: a Grid is read-only once made (pickle.loads makes a new one).")
+      .def("__reduce__", [](const PyGrid& self) {
+        return py::make_tuple(py::module_::import("libvox").attr("_unpickle_grid"), py::make_tuple(getState(self)));
       });
+  // pybind11 2.10 takes every method named __setstate__ for a constructor, which its dispatcher skips without a word
+  // on an initialised instance (issue 45: it did nothing and raised nothing): this one is a plain method.
+  functionRecord(py::detail::get_function(grid.attr("__setstate__")))->is_constructor = false;
+  m.def("_grid_from_state", &fromState, py::arg("state"),
+        "The Grid of a pickle state (libvox._unpickle_grid calls it): InputError for corrupt bytes, TypeError for a "
+        "state that is not (bytes, str).");
 
   m.def(
       "load",

@@ -14,4 +14,6 @@ PYBIND11_MODULE(_libvox, m) {
   voxpy::bindVoxelize(m);
   voxpy::bindRender(m);
   voxpy::bindBench(m);
+  voxpy::nameBadCalls(m, grid);  // last: every function and method defined
+  voxpy::nameBadCalls(grid, grid);
 }

@@ -38,7 +38,7 @@ struct Source {
   // A message about this source: the label, then the path unless the message names it already (the importers'
   // messages and warnings start with it), so that no message says the path twice.
   std::string describe(const std::string& message) const {
-    if (name != "<arrays>" && message.rfind(name, 0) == 0) return label + message;
+    if (message.rfind(name, 0) == 0) return label + message;  // "<arrays>: " too (checkMemory names it)
     if (name == "<arrays>" && !label.empty()) return label + message;
     return label + name + ": " + message;
   }

@@ -23,7 +23,7 @@ def describe(grid):
         "ids": np.array(ids),
         "solid": grid.solid_indices,
         "bounds": grid.bounds,
-        "state": grid.__reduce__()[2],
+        "state": grid.__getstate__(),
     }
 
 

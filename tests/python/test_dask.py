@@ -79,7 +79,7 @@ def test_grids_gathered_equal_voxelize_batch(client, paths):
         assert_same_grid(a, b)
         assert a.source == b.source
         assert np.array_equal(a.dense(), b.dense())
-        assert a.__reduce__()[2] == b.__reduce__()[2]  # the same grid file bytes
+        assert a.__getstate__() == b.__getstate__()  # the same grid file bytes
     assert np.array_equal(np.stack([g.dense() for g in gathered]), libvox.voxelize_batch(paths, RES, fill=True))
 
 

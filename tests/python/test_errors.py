@@ -147,3 +147,110 @@ def test_outputs(tmp_path):
             grid.save(ro / "g.vgrid")
     # The interpreter lives on and the module still works.
     assert libvox.voxelize((V, F), resolution=4).occupied_count > 0
+
+
+# Issue 45, defect 13: the Python side's messages.
+def test_sdf_names_the_source_once():
+    with pytest.raises(libvox.LimitError) as caught:
+        libvox.sdf((V, F), dims=4096)  # 512 GiB of float64: refused before any work
+    message = str(caught.value)
+    assert message.startswith("<arrays>: sdf() needs about") and message.count("<arrays>") == 1, message
+
+
+def test_calls_that_do_not_fit_name_the_argument():
+    with pytest.raises(TypeError, match=r"^sdf\(\) got an unexpected keyword argument 'method' \(it takes source, "
+                                        r"resolution, dims, pitch, bounds, threads, progress\)$"):
+        libvox.sdf((V, F), method="exact")
+    with pytest.raises(TypeError, match=r"^sdf\(\) takes 1 positional argument \(source\) but 2 were given; "
+                                        r"resolution, dims, pitch, bounds, threads, progress are keyword-only"):
+        libvox.sdf((V, F), 8)
+    grid = libvox.voxelize((V, F), resolution=4)
+    with pytest.raises(TypeError, match=r"^Grid.dense\(\) takes at most 1 positional argument \(solid\) but 2 were"):
+        grid.dense(True, 1)
+    with pytest.raises(TypeError, match=r"^Grid.save\(\) got multiple values for argument 'path'$"):
+        grid.save("a.vgrid", path="b.vgrid")
+    with pytest.raises(TypeError, match=r"^Grid.distance\(\) missing required argument 'points'$"):
+        grid.distance()
+    with pytest.raises(TypeError, match=r"^render\(\): grid must be a libvox.Grid, not str$"):
+        libvox.render("bunny.vgrid")
+    with pytest.raises(TypeError, match=r"^Grid.save\(\) needs a libvox.Grid to work on, not int$"):
+        libvox.Grid.save(42, "x.vgrid")
+
+
+def test_none_is_named_as_none():
+    grid = libvox.voxelize((V, F), resolution=4)
+    with pytest.raises(TypeError, match=r"^points must be an array of numbers \(or a sequence of them\), not "
+                                        r"NoneType$"):
+        grid.distance(None)
+    with pytest.raises(TypeError, match=r"not a list of other objects$"):
+        grid.distance([[None, None, None]])
+    with pytest.raises(TypeError, match=r"not dtype object$"):
+        grid.distance(np.array([[1, 2, 3]], dtype=object))
+
+
+# Every function and method, called with an unknown keyword and with one positional argument too many: a TypeError
+# naming the call and what is wrong, never pybind11's "incompatible function arguments".
+def audit_calls(tmp_path):
+    grid = libvox.voxelize((V, F), resolution=4)
+    grid.save(tmp_path / "g.vgrid")
+    ray = ([[0.2, 0.2, -1]], [[0, 0, 1]])
+    return {
+        "voxelize": (libvox.voxelize, ((V, F),)),
+        "sdf": (libvox.sdf, ((V, F),)),
+        "voxelize_batch": (libvox.voxelize_batch, ([(V, F)],)),
+        "load": (libvox.load, (tmp_path / "g.vgrid",)),
+        "render": (libvox.render, (grid,)),
+        "save_image": (libvox.save_image, (tmp_path / "i.png", np.zeros((2, 2, 3), np.float32))),
+        "_voxelize_loop": (libvox._libvox._voxelize_loop, ([(V, F)], 4)),
+        "_grid_from_state": (libvox._libvox._grid_from_state, (grid.__getstate__(),)),
+        "Grid.save": (grid.save, (tmp_path / "h.vgrid",)),
+        "Grid.dense": (grid.dense, ()),
+        "Grid.contains": (grid.contains, ([[0, 0, 0]],)),
+        "Grid.intersect": (grid.intersect, ray),
+        "Grid.occluded": (grid.occluded, ray),
+        "Grid.distance": (grid.distance, ([[0, 0, 0]],)),
+        "Grid.mesh": (grid.mesh, ()),
+        "Grid.colors": (grid.colors, ()),
+        "Grid.__repr__": (grid.__repr__, ()),
+        "Grid.__reduce__": (grid.__reduce__, ()),
+        "Grid.__getstate__": (grid.__getstate__, ()),
+        "Grid.__setstate__": (grid.__setstate__, (grid.__getstate__(),)),
+    }
+
+
+def test_audit_covers_every_function(tmp_path):
+    native = libvox._libvox
+    functions = {n for n in dir(native) if callable(getattr(native, n)) and not isinstance(getattr(native, n), type)
+                 and not n.startswith("__")}
+    methods = {"Grid." + n for n, v in vars(libvox.Grid).items() if callable(v) and (not n.startswith("__") or n in (
+        "__repr__", "__reduce__", "__getstate__", "__setstate__"))}
+    assert functions | methods == set(audit_calls(tmp_path)) == set(AUDITED)
+
+
+def positional_count(function):
+    """The parameters that can be given by position, from the signature on the docstring's first line."""
+    import ast
+    first = function.__doc__.splitlines()[0]
+    params = first[first.index("(") + 1:first.rindex(") -> ")]
+    args = ast.parse(f"def f({params}): pass").body[0].args
+    return len(args.posonlyargs + args.args) - (1 if args.args and args.args[0].arg == "self" else 0)
+
+
+AUDITED = ["voxelize", "sdf", "voxelize_batch", "load", "render", "save_image", "_voxelize_loop", "_grid_from_state",
+           "Grid.save", "Grid.dense", "Grid.contains", "Grid.intersect", "Grid.occluded", "Grid.distance", "Grid.mesh",
+           "Grid.colors", "Grid.__repr__", "Grid.__reduce__", "Grid.__getstate__", "Grid.__setstate__"]
+
+
+@pytest.mark.parametrize("name", AUDITED)
+def test_wrong_keyword_and_extra_positional(tmp_path, name):
+    function, args = audit_calls(tmp_path)[name]
+    short = name.split(".")[-1]
+    with pytest.raises(TypeError) as caught:
+        function(*args, no_such_argument=1)
+    message = str(caught.value)
+    assert "incompatible" not in message and "'no_such_argument'" in message and f"{short}()" in message, message
+    extra = list(args) + [None] * (positional_count(function) - len(args) + 1)
+    with pytest.raises(TypeError) as caught:
+        function(*extra)
+    message = str(caught.value)
+    assert "incompatible" not in message and "positional argument" in message and f"{short}()" in message, message

@@ -9,6 +9,9 @@ import copy
 import copyreg
 import multiprocessing
 import pickle
+import subprocess
+import sys
+import textwrap
 
 import numpy as np
 import pytest
@@ -99,7 +102,7 @@ def test_loaded_grid_and_copies(tmp_path):
     assert_identical(grid, copy.copy(grid), tmp_path)
     assert_identical(grid, copy.deepcopy(grid), tmp_path)
     # The state is the grid file as Grid.save writes it, and its source.
-    state = grid.__reduce__()[2]
+    state = grid.__getstate__()
     assert state == (path.read_bytes(), str(path))
 
 
@@ -132,8 +135,8 @@ def test_spawn_pool():
         assert np.array_equal(view["offsets"], offsets) and np.array_equal(view["ids"], ids)
         assert np.array_equal(view["solid"], grid.solid_indices)
         assert np.array_equal(view["bounds"], grid.bounds)
-        assert view["state"] == grid.__reduce__()[2]
-        assert back.__reduce__()[2] == grid.__reduce__()[2]
+        assert view["state"] == grid.__getstate__()
+        assert back.__getstate__() == grid.__getstate__()
 
 
 @pytest.mark.parametrize("context", ["fork", "spawn"])
@@ -147,7 +150,7 @@ def test_process_pool_executor(context):
         assert_same_grid(grid, here)
         assert_same_grid(back, here)
         assert np.array_equal(back.dense(), here.dense())
-        assert back.__reduce__()[2][0] == here.__reduce__()[2][0]
+        assert back.__getstate__()[0] == here.__getstate__()[0]
 
 
 class Forged:
@@ -157,20 +160,20 @@ class Forged:
         self.state = state
 
     def __reduce__(self):
-        return copyreg.__newobj__, (libvox.Grid,), self.state
+        return libvox._unpickle_grid, (self.state,)
 
 
 def loads_forged(state):
-    return pickle.loads(pickle.dumps(Forged(state), protocol=1))  # 2 and up check the class of the object
+    return pickle.loads(pickle.dumps(Forged(state)))
 
 
 def test_forged_pickle_of_the_real_state_loads(tmp_path):
     grid = make("spheres_course_fill")
-    assert_identical(grid, loads_forged(grid.__reduce__()[2]), tmp_path)
+    assert_identical(grid, loads_forged(grid.__getstate__()), tmp_path)
 
 
 def test_truncated_grid_bytes_raise_input_error():
-    data, source = make("tet_arrays_fill").__reduce__()[2]
+    data, source = make("tet_arrays_fill").__getstate__()
     for n in range(len(data)):
         with pytest.raises(libvox.InputError, match="pickled grid"):
             loads_forged((data[:n], source))
@@ -182,7 +185,7 @@ def test_flipped_bytes_raise_input_error():
     """Every byte of the grid file inside a real pickle, flipped: InputError each time (the checksum and the header's
     checks), never a crash or a different grid."""
     grid = make("tet_arrays_fill")
-    data = grid.__reduce__()[2][0]
+    data = grid.__getstate__()[0]
     pickled = pickle.dumps(grid)
     at = pickled.find(data)
     assert at > 0
@@ -195,7 +198,7 @@ def test_flipped_bytes_raise_input_error():
 
 
 def test_newer_version_raises_input_error():
-    data, source = make("tet_arrays_fill").__reduce__()[2]
+    data, source = make("tet_arrays_fill").__getstate__()
     version = data.find((3).to_bytes(4, "little"))
     assert 0 < version < 32
     newer = data[:version] + (99).to_bytes(4, "little") + data[version + 4:]
@@ -209,12 +212,176 @@ def test_not_a_grid_file_raises_input_error():
             loads_forged((junk, "<arrays>"))
 
 
-@pytest.mark.parametrize("state", [int, 42, "text", b"bytes", (), ("text", "src"), (b"x",),
-                                   (b"x", b"src"), (b"x", "src", 1), [b"x", "src"], {"bytes": b"x"}],
-                         ids=repr)
-def test_state_of_the_wrong_type_raises_type_error(state):
+# Issue 45: each message says what is wrong with the state (it said "must be a tuple ..., got tuple").
+@pytest.mark.parametrize("state,message", [
+    (int, "not type"), (42, "not int"), ("text", "not str"), (b"bytes", "not bytes"), ([b"x", "src"], "not list"),
+    ({"bytes": b"x"}, "not dict"), (None, "not NoneType"),
+    ((), "got a tuple of 0 items"), ((b"x",), "got a tuple of 1 items"), ((b"x", "src", 1), "got a tuple of 3 items"),
+    (("text", "src"), "its first item is str, not bytes"), ((b"x", b"src"), "its second item is bytes, not str"),
+], ids=repr)
+def test_state_of_the_wrong_type_raises_type_error(state, message):
     grid = make("tet_arrays_fill")
     if isinstance(state, tuple) and len(state) == 2 and state[0] == b"x":
-        state = (grid.__reduce__()[2][0], state[1])  # good bytes, a bad source
-    with pytest.raises(TypeError, match="__setstate__"):
+        state = (grid.__getstate__()[0], state[1])  # good bytes, a bad source
+    with pytest.raises(TypeError, match=r"^pickled libvox.Grid: the state must be \(grid file bytes, source str\)[,:] "
+                                        + message + "$"):
         loads_forged(state)
+
+
+def test_old_style_pickles_raise_type_error():
+    """Grid.__new__ refuses (issue 45): the stream of copyreg.__newobj__(Grid) with or without a state (what
+    libvox wrote before, and the 25-byte stream that gave a Grid without its grid) raises TypeError."""
+    class OldStyle:
+        def __init__(self, *state):
+            self.state = state
+
+        def __reduce__(self):
+            return (copyreg.__newobj__, (libvox.Grid,)) + self.state
+
+    # Protocols 0 and 1 through copyreg.__newobj__; 2 and up with the NEWOBJ opcode (pickle.dumps would check the
+    # class, so the stream is written here: PROTO, GLOBAL libvox._libvox Grid, EMPTY_TUPLE, NEWOBJ, STOP).
+    streams = [pickle.dumps(OldStyle(*state), protocol=protocol) for protocol in (0, 1)
+               for state in ((), (make("tet_arrays_fill").__getstate__(),))]
+    streams += [b"\x80" + bytes([protocol]) + b"clibvox._libvox\nGrid\n)\x81." for protocol in range(2, 6)]
+    assert len(streams[-1]) < 30
+    for stream in streams:
+        with pytest.raises(TypeError, match="libvox.Grid cannot be made directly"):
+            pickle.loads(stream)
+    with pytest.raises(TypeError, match="libvox.Grid cannot be made directly"):
+        libvox.Grid.__new__(libvox.Grid)
+    with pytest.raises(TypeError, match="libvox.Grid cannot be made directly"):
+        libvox.Grid()
+
+
+def test_setstate_of_a_live_grid_raises_and_changes_nothing():
+    """Issue 45, defect 14: __setstate__ on a live Grid did nothing and raised nothing."""
+    grid, other = make("tet_arrays_fill"), make("bunny_obj")
+    before = grid.__getstate__()
+    for state in (other.__getstate__(), before, 42):
+        with pytest.raises(TypeError, match="already initialised"):
+            grid.__setstate__(state)
+        assert grid.__getstate__() == before
+
+
+def run_child(script, *args):
+    """A child interpreter: a crash there fails the test instead of ending pytest."""
+    return subprocess.run([sys.executable, "-c", script, *map(str, args)], capture_output=True, text=True,
+                          timeout=600)
+
+
+# Issue 45, defect 3: a Grid object without its C++ grid (pybind11's base __new__ still makes one, bypassing
+# Grid.__new__) raises TypeError from every attribute and method, repr and pickle included, instead of reading
+# uninitialised memory.
+BARE = textwrap.dedent("""
+    import pickle, sys
+    import libvox
+    bare = libvox.Grid.__mro__[1].__new__(libvox.Grid)
+    ray = [[0.5, 0.5, -1]], [[0, 0, 1]]
+    ARGS = {"save": ("x.vgrid",), "contains": ([[0, 0, 0]],), "distance": ([[0, 0, 0]],), "intersect": ray,
+            "occluded": ray, "__setstate__": (None,)}
+    calls = {"repr": lambda: repr(bare), "pickle": lambda: pickle.dumps(bare), "str": lambda: str(bare),
+             "render": lambda: libvox.render(bare)}
+    for name in dir(libvox.Grid):
+        if name.startswith("__") and name not in ("__getstate__", "__setstate__", "__reduce__", "__repr__"):
+            continue
+        member = getattr(libvox.Grid, name)
+        if isinstance(member, property):
+            calls[name] = (lambda n: lambda: getattr(bare, n))(name)
+        else:
+            args = ARGS.get(name, ())
+            calls[name] = (lambda m, a: lambda: m(bare, *a))(member, args)
+    for name, call in calls.items():
+        try:
+            call()
+            print(name, "returned")
+        except TypeError as e:
+            print(name, "TypeError", "holds no grid" in str(e))
+    print("alive")
+""")
+
+
+def test_grid_without_its_grid_raises_type_error():
+    proc = run_child(BARE)
+    assert proc.returncode == 0, f"exit {proc.returncode}\n{proc.stdout}{proc.stderr}"
+    lines = proc.stdout.splitlines()
+    assert lines[-1] == "alive"
+    assert len(lines) > 25, proc.stdout  # every property and method was tried
+    assert all(line.endswith("TypeError True") for line in lines[:-1]), proc.stdout
+
+
+# Mutated and truncated pickles of a small grid, all in one child (which would end on a crash): each one loads as
+# the same grid, or raises an exception of the documented kinds (ValueError and its subclasses InputError and
+# UsageError, TypeError, UnpicklingError) or one of pickle's own about the stream (EOFError for a truncation, a
+# name that does not resolve, a memo or stack error); never a different Grid, never a crash.
+FUZZ = textwrap.dedent("""
+    import collections, pickle, random, resource, sys
+    import numpy as np
+    import libvox
+    # A mutated memo index or length makes pickle itself allocate and clear gigabytes (seconds a stream): a limit
+    # on the address space turns that into a quick MemoryError.
+    resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=np.float64)
+    F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    grid = libvox.voxelize((V, F), resolution=3, fill=True)
+    state = grid.__getstate__()
+    # pickle's own about a broken stream: EOFError (cut short), ImportError and AttributeError (a name that does not
+    # resolve), LookupError (a memo key, the codec name of protocols 0 to 2), OverflowError, MemoryError, RecursionError.
+    ALLOWED = (ValueError, TypeError, pickle.UnpicklingError, EOFError, ImportError, AttributeError, LookupError,
+               MemoryError, OverflowError, RecursionError)
+    rng = random.Random(int(sys.argv[1]))
+    outcomes = collections.Counter()
+
+    def grids_in(obj, depth=0):
+        if isinstance(obj, libvox.Grid):
+            yield obj
+        elif isinstance(obj, (tuple, list, set, frozenset)) and depth < 5:
+            for item in obj:
+                yield from grids_in(item, depth + 1)
+        elif isinstance(obj, dict) and depth < 5:
+            for item in obj.items():
+                yield from grids_in(item, depth + 1)
+
+    def mutated(stream):
+        data = bytearray(stream)
+        for _ in range(rng.choice((1, 1, 2, 3, 8))):
+            kind, at = rng.randrange(4), rng.randrange(len(data))
+            if kind == 0:
+                data[at] = rng.randrange(256)
+            elif kind == 1:
+                data[at] ^= 1 << rng.randrange(8)
+            elif kind == 2:
+                del data[at:at + rng.randrange(1, 16)]
+            else:
+                data[at:at] = bytes(rng.randrange(256) for _ in range(rng.randrange(1, 8)))
+        return bytes(data)
+
+    streams = []
+    for protocol in range(pickle.HIGHEST_PROTOCOL + 1):
+        stream = pickle.dumps(grid, protocol=protocol)
+        streams += [stream[:n] for n in range(len(stream))]
+        streams += [mutated(stream) for _ in range(int(sys.argv[2]))]
+    for stream in streams:
+        try:
+            loaded = pickle.loads(stream)
+        except ALLOWED as e:
+            outcomes[type(e).__name__] += 1
+            continue
+        except Exception as e:
+            print("unexpected", type(e).__name__, e, stream)
+            continue
+        for g in grids_in(loaded):
+            if g.__getstate__()[0] != state[0]:  # the grid; its source is a name the stream may spell otherwise
+                print("a different grid from", stream)
+            outcomes["equal grid"] += 1
+        outcomes["loaded"] += 1
+    print(len(streams), dict(outcomes))
+""")
+
+
+def test_fuzzed_pickles_load_equal_or_raise():
+    proc = run_child(FUZZ, 45, 2000)
+    assert proc.returncode == 0, f"exit {proc.returncode}\n{proc.stdout[-2000:]}{proc.stderr[-2000:]}"
+    assert "a different grid" not in proc.stdout and "unexpected" not in proc.stdout, proc.stdout[-2000:]
+    count, outcomes = proc.stdout.split(" ", 1)
+    assert int(count) > 2000
+    assert "equal grid" in outcomes and "InputError" in outcomes, outcomes  # both kinds were reached

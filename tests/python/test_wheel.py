@@ -30,7 +30,7 @@ SCRIPT = textwrap.dedent("""
     assert grid.dims == (16, 16, 16) and grid.solid_count > 0
     back = pickle.loads(pickle.dumps(grid))
     assert np.array_equal(back.dense(), grid.dense())
-    assert back.__reduce__()[2] == grid.__reduce__()[2]
+    assert back.__getstate__() == grid.__getstate__()
     libvox.save_image("tet.png", libvox.render(back, size=(32, 24)))
     with open("tet.png", "rb") as png:
         assert png.read(8) == b"\\x89PNG\\r\\n\\x1a\\n"

@@ -72,32 +72,66 @@ extern "C" void removeTemporariesAndExit(int signal) {
   ::_exit(128 + signal);
 }
 
-// A signal the process was started with ignored (nohup, a background job of a non-interactive shell) stays ignored:
-// the user asked for that.
-void installSignalHandlers() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
-      struct sigaction old {};
-      if (::sigaction(sig, nullptr, &old) != 0 || old.sa_handler == SIG_IGN) continue;
-      struct sigaction act {};
-      act.sa_handler = removeTemporariesAndExit;
-      sigfillset(&act.sa_mask);  // one handler at a time: a second signal must not interrupt the unlinks
-      ::sigaction(sig, &act, nullptr);
-    }
-    // A write past RLIMIT_FSIZE then fails with EFBIG, which the writers report ("File too large") and which
-    // removes the temporary file, instead of SIGXFSZ killing the process with the temporary file left behind.
-    struct sigaction xfsz {};
-    if (::sigaction(SIGXFSZ, nullptr, &xfsz) == 0 && xfsz.sa_handler == SIG_DFL) ::signal(SIGXFSZ, SIG_IGN);
-  });
+// ---- The handlers, installed only while a write is under way ----
+// A library must leave the process as it found it: the handlers are installed when the first temporary file or
+// folder is registered and the previous dispositions restored when the last one is released (a count under a
+// mutex: writes run on several threads at once). Only a default disposition (which would end the process and leave
+// the temporary behind) is replaced:
+//  - a signal ignored (nohup, a background job of a non-interactive shell) stays ignored: the user asked for that;
+//  - a handler of the host's own (Python's SIGINT handler, which raises KeyboardInterrupt) keeps working: the host
+//    decides, and a write it abandons removes its temporary through the destructors (OutputFile, TemporaryFolder),
+//    the old output whole. Replacing it with one that _exits would kill an interpreter on Ctrl-C.
+constexpr std::array<int, 3> kSignals{SIGINT, SIGTERM, SIGHUP};
+std::mutex gHandlersMutex;
+int gRegistered = 0;                                      // temporary files and folders registered (gHandlersMutex)
+std::array<struct sigaction, kSignals.size()> gPrevious;  // what each replaced disposition was
+std::array<bool, kSignals.size()> gReplaced{};
+bool gXfszIgnored = false;
+
+bool isDefault(const struct sigaction& a) { return !(a.sa_flags & SA_SIGINFO) && a.sa_handler == SIG_DFL; }
+
+// Whether `sig` is still handled as we set it (`handler`): a disposition someone set since is theirs and stays.
+bool stillOurs(int sig, void (*handler)(int)) {
+  struct sigaction now {};
+  return ::sigaction(sig, nullptr, &now) == 0 && !(now.sa_flags & SA_SIGINFO) && now.sa_handler == handler;
+}
+
+void acquireSignalHandlers() {
+  std::lock_guard lock(gHandlersMutex);
+  if (gRegistered++ > 0) return;
+  for (size_t i = 0; i < kSignals.size(); ++i) {
+    gReplaced[i] = false;
+    struct sigaction old {};
+    if (::sigaction(kSignals[i], nullptr, &old) != 0 || !isDefault(old)) continue;
+    struct sigaction act {};
+    act.sa_handler = removeTemporariesAndExit;
+    sigfillset(&act.sa_mask);  // one handler at a time: a second signal must not interrupt the unlinks
+    gReplaced[i] = ::sigaction(kSignals[i], &act, &gPrevious[i]) == 0;
+  }
+  // A write past RLIMIT_FSIZE then fails with EFBIG, which the writers report ("File too large") and which
+  // removes the temporary file, instead of SIGXFSZ killing the process with the temporary file left behind.
+  struct sigaction xfsz {};
+  gXfszIgnored = ::sigaction(SIGXFSZ, nullptr, &xfsz) == 0 && isDefault(xfsz) && ::signal(SIGXFSZ, SIG_IGN) != SIG_ERR;
+}
+
+void releaseSignalHandlers() {
+  std::lock_guard lock(gHandlersMutex);
+  if (--gRegistered > 0) return;
+  for (size_t i = 0; i < kSignals.size(); ++i)
+    if (gReplaced[i] && stillOurs(kSignals[i], removeTemporariesAndExit))
+      ::sigaction(kSignals[i], &gPrevious[i], nullptr);
+  if (gXfszIgnored && stillOurs(SIGXFSZ, SIG_IGN)) ::signal(SIGXFSZ, SIG_DFL);
+  gReplaced.fill(false);
+  gXfszIgnored = false;
 }
 
 // Returns the slot index, or -1 when the path is too long or all slots are taken (the file is then not removed on a
-// signal, which is the old behaviour, rather than refusing to write).
+// signal, which is the old behaviour, rather than refusing to write). A slot holds the handlers (above) until
+// unpublishIn frees it; the handlers are installed before the path is published, and released after it is not.
 template <size_t N>
 int publishIn(std::array<Slot, N>& slots, const std::string& path) {
-  installSignalHandlers();
   if (path.size() >= kPathBytes) return -1;
+  acquireSignalHandlers();
   for (size_t i = 0; i < N; ++i) {
     int expected = kFree;
     if (!slots[i].state.compare_exchange_strong(expected, kClaimed, std::memory_order_acquire)) continue;
@@ -105,14 +139,20 @@ int publishIn(std::array<Slot, N>& slots, const std::string& path) {
     slots[i].state.store(kLive, std::memory_order_release);
     return int(i);
   }
+  releaseSignalHandlers();
   return -1;
+}
+
+template <size_t N>
+void unpublishIn(std::array<Slot, N>& slots, int slot) {
+  if (slot < 0) return;
+  slots[size_t(slot)].state.store(kFree, std::memory_order_release);
+  releaseSignalHandlers();
 }
 
 int publishTemporary(const std::string& path) { return publishIn(gSlots, path); }
 
-void unpublishTemporary(int slot) {
-  if (slot >= 0) gSlots[size_t(slot)].state.store(kFree, std::memory_order_release);
-}
+void unpublishTemporary(int slot) { unpublishIn(gSlots, slot); }
 
 // ---- Checked I/O ----
 // Writes all of [data, data + size) or returns the errno that stopped it (0 on success).
@@ -318,7 +358,7 @@ TemporaryFolder::TemporaryFolder(const std::string& path, bool create) : path_(p
   slot_ = publishIn(gFolderSlots, path_);
   if (create && ::mkdir(path_.c_str(), 0777) != 0) {
     const int err = errno;
-    if (slot_ >= 0) gFolderSlots[size_t(slot_)].state.store(kFree, std::memory_order_release);
+    unpublishIn(gFolderSlots, slot_);
     slot_ = -1;
     fail<OutputError>(path_, ": cannot create the folder: ", std::strerror(err));
   }
@@ -336,7 +376,7 @@ TemporaryFolder::~TemporaryFolder() {
 }
 
 void TemporaryFolder::keep() {
-  if (slot_ >= 0) gFolderSlots[size_t(slot_)].state.store(kFree, std::memory_order_release);
+  unpublishIn(gFolderSlots, slot_);
   slot_ = -1;
   owner_ = false;
 }

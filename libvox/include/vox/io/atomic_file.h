@@ -16,8 +16,12 @@ namespace vox {
 // One output being written. The constructor opens the temporary file (`.NAME.tmpPID_N.EXT` beside `path`) or the
 // device; write() and stream() add bytes; commit() makes them the output. Destroying an uncommitted OutputFile
 // removes the temporary file, so an exception anywhere leaves the old output as it was. While the temporary file
-// exists its name sits in a registry that a SIGINT/SIGTERM handler (installed on first use, unless the signal is
-// ignored) unlinks before it ends the process with _exit(128 + signal).
+// exists its name sits in a registry that a SIGINT/SIGTERM/SIGHUP handler unlinks before it ends the process with
+// _exit(128 + signal). That handler is installed only while a temporary file or folder is registered, and only for
+// a signal whose disposition is the default one (SIGXFSZ is ignored likewise); the previous dispositions are
+// restored when the last registration ends. A signal the process ignores stays ignored, and a handler of the host's
+// own (Python's SIGINT, raising KeyboardInterrupt) stays in place: the host then ends the write by its exception
+// path and the destructors remove the temporary.
 // @throw OutputError "PATH: cannot write: REASON" from every member when the output cannot be written.
 class OutputFile {
  public:
@@ -48,7 +52,8 @@ class OutputFile {
 
 // A folder of new files that becomes an output only when something names it (a grid set's generation folder, named
 // by its manifest): created here, and removed with the files in it by the destructor unless keep() was called, and
-// by the SIGINT/SIGTERM/SIGHUP handler of OutputFile while it is registered. Holds files only, no subfolders.
+// by the SIGINT/SIGTERM/SIGHUP handler of OutputFile while it is registered (until keep() or destruction, with the
+// same rules for installing and restoring the handlers). Holds files only, no subfolders.
 // @throw OutputError "PATH: cannot create the folder: REASON" from the constructor when `create` and mkdir fails
 // (EEXIST included: the folder must be new, so that nothing in it belongs to anyone else).
 class TemporaryFolder {

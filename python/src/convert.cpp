@@ -9,6 +9,7 @@
 #include <cstring>
 
 #include "vox/core/error.h"
+#include "vox/core/exact_number.h"
 
 namespace voxpy {
 
@@ -167,10 +168,11 @@ vox::Box boxArg(const py::handle& obj, const std::string& name) {
   const vox::Box b{vec3Arg(corners[0], name + "[0]"), vec3Arg(corners[1], name + "[1]")};
   for (int a = 0; a < 3; ++a) {
     if (!(b.lo[a] < b.hi[a]))
-      vox::fail<vox::UsageError>(name, ": minimum must be below maximum on every axis (", "xyz"[a], ": ", b.lo[a],
-                                 " and ", b.hi[a], ")");
+      vox::fail<vox::UsageError>(name, ": minimum must be below maximum on every axis (", "xyz"[a], ": ",
+                                 vox::exactNumber(b.lo[a]), " and ", vox::exactNumber(b.hi[a]), ")");
     if (!std::isfinite(b.hi[a] - b.lo[a]))
-      vox::fail<vox::UsageError>(name, ": the extent on axis ", "xyz"[a], " (", b.lo[a], " to ", b.hi[a],
+      vox::fail<vox::UsageError>(name, ": the extent on axis ", "xyz"[a], " (", vox::exactNumber(b.lo[a]), " to ",
+                                 vox::exactNumber(b.hi[a]),
                                  ") is wider than the largest double: no grid can divide it");
   }
   return b;

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "binding.h"
+#include "vox/core/exact_number.h"
 #include "vox/core/error.h"
 #include "vox/io/image_io.h"
 #include "vox/io/input_file.h"
@@ -63,7 +64,7 @@ vox::Camera resolveCamera(const PyGrid& g, const py::object& eye, const py::obje
   }
   if (!fov.is_none()) {
     const double f = floatArg(fov, "fov");
-    if (!(f > 0 && f < 180)) fail<UsageError>("fov must be between 0 and 180 degrees, got ", f);
+    if (!(f > 0 && f < 180)) fail<UsageError>("fov must be between 0 and 180 degrees, got ", vox::exactNumber(f));
     cam.kind = CameraKind::Perspective;
     cam.fovDegrees = f;
     cam.span = CameraSpan::Height;  // fov is vertical, whatever the scene's camera spans
@@ -91,7 +92,7 @@ vox::RenderOptions renderOptions(const py::object& size, const py::object& mode,
   ro.samples = uint32_t(intArg(samples, "samples", 1, kMaxSamples));
   ro.bounces = uint32_t(intArg(bounces, "bounces", 0, kMaxBounces));
   ro.weight = floatArg(weight, "weight");
-  if (!(ro.weight >= 0)) fail<UsageError>("weight must be a finite number >= 0, got ", ro.weight);
+  if (!(ro.weight >= 0)) fail<UsageError>("weight must be a finite number >= 0, got ", vox::exactNumber(ro.weight));
   ro.shadeBack = boolArg(shadeBack, "shade_back");
   ro.shadows = boolArg(shadows, "shadows");
   if (!filter.is_none()) {
@@ -99,7 +100,8 @@ vox::RenderOptions renderOptions(const py::object& size, const py::object& mode,
     ro.filter = enumArg(f[0], "filter kind", parseFilter);
     ro.filterRadius = floatArg(f[1], "filter radius");
     if (!(ro.filterRadius > 0 && ro.filterRadius <= kMaxFilterRadius))
-      fail<UsageError>("filter radius must be in (0, ", kMaxFilterRadius, "] pixels, got ", ro.filterRadius);
+      fail<UsageError>("filter radius must be in (0, ", kMaxFilterRadius, "] pixels, got ",
+                       vox::exactNumber(ro.filterRadius));
   }
   return ro;
 }

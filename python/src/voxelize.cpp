@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "binding.h"
+#include "vox/core/exact_number.h"
 #include "vox/core/error.h"
 #include "vox/export/voxel_runs.h"
 #include "vox/import/import.h"
@@ -144,7 +145,7 @@ auto namedAfter(const Source& src, Work&& work) -> decltype(work()) {
 vox::Vec3 pitchArg(const py::object& pitch) {
   const vox::Vec3 size = isSequence(pitch) ? vec3Arg(pitch, "pitch") : vox::Vec3{1, 1, 1} * floatArg(pitch, "pitch");
   for (int a = 0; a < 3; ++a)
-    if (!(size[a] > 0)) vox::fail<vox::UsageError>("pitch must be positive, got ", size[a]);
+    if (!(size[a] > 0)) vox::fail<vox::UsageError>("pitch must be positive, got ", vox::exactNumber(size[a]));
   return size;
 }
 

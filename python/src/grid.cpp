@@ -18,11 +18,11 @@ const vox::Accel& PyGrid::accel() {
 }
 
 const vox::NearestPrimitive& PyGrid::nearest() {
-  return nearest_.get([&] { return vox::NearestPrimitive(file_->scene); });
+  return nearest_.get([&] { return vox::NearestPrimitive(file_->scene, vox::sceneFrame(file_->scene)); });
 }
 
 const vox::InsideTest& PyGrid::insideTest() {
-  return insideTest_.get([&] { return vox::InsideTest(file_->scene); });
+  return insideTest_.get([&] { return vox::InsideTest(file_->scene, vox::sceneFrame(file_->scene)); });
 }
 
 namespace {

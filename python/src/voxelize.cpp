@@ -195,6 +195,7 @@ std::shared_ptr<PyGrid> voxelize(const py::object& source, const py::object& res
     return namedAfter(src, [&] {
       if (sdfHalfWidth) vo = vox::withCubicCells(scene, vo);  // as vox-voxelize --sdf: a level set's cubic cells
       if (doFractions) vox::checkVolumeFractionsPossible(scene, vo.method, vo.memoryLimitBytes);
+      vox::checkNumericDomainOfPlan(scene, vo, sdfHalfWidth.has_value(), doFractions);  // before any work
       vox::Grid g = vox::voxelizeScene(scene, vo);
       if (doFill) {
         vox::FillOptions fo;
@@ -247,6 +248,7 @@ py::array_t<double> denseSdf(const py::object& source, const py::object& resolut
       vo = vox::withCubicCells(scene, vo);
       // The dense array is refused before any work: the plan alone gives its size.
       vox::checkMemory(double(vox::planGrid(scene, vo).cellCount()) * 8, src.name, "sdf()");
+      vox::checkNumericDomainOfPlan(scene, vo, true, false);
       vox::Grid g = vox::voxelizeScene(scene, vo);
       vox::FillOptions fo;
       fo.memoryLimitBytes = vo.memoryLimitBytes;

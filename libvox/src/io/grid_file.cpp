@@ -241,6 +241,7 @@ void streamPayload(const Scene& scene, const Grid& grid, const EncodedCellTable&
 uint32_t gridFileVersionFor(const Grid& grid) { return grid.sdfHalfWidth > 0 || !grid.fractions.empty() ? 4 : 3; }
 
 std::string encodeGridFile(const Scene& scene, const Grid& grid, uint32_t version) {
+  checkGridBeforeWrite(grid, "grid file");
   if (version == 0) version = gridFileVersionFor(grid);
   if (version < gridFileVersionFor(grid) && version >= 3)
     fail<UsageError>("grid file version ", version, " cannot hold distances or volume fractions");
@@ -434,6 +435,7 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
 void writeGridFile(const std::string& path, const Scene& scene, const Grid& grid, WriteTimes* times) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
+  checkGridBeforeWrite(grid, path);  // before the output is opened: nothing is written that a reader refuses
   // Three passes over the encoding instead of the whole file in memory (at 1024^3 the file is as large as the grid):
   // the size, which seeds the checksum; the checksum; then the bytes, header first, through a temporary file.
   // The cell table, the bulk of the file, is encoded once.

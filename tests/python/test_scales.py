@@ -76,13 +76,14 @@ def test_huge_cube_band_inside_the_grid_and_saved(tmp_path):
 
 def test_coinciding_cell_boundaries_refused():
     """Defect 9: a unit cube moved to 1e16 (cells of 1/8 where doubles are 2 apart) gave NaN fractions."""
-    v = V + 1e16
-    for kwargs in ({"fraction": True}, {"sdf": 3}):
-        with pytest.raises(libvox.InputError, match=r"coincide; use fewer cells") as e:
-            libvox.voxelize((v, F), resolution=8, **kwargs)
-        assert "\n" not in str(e.value)
-    with pytest.raises(libvox.InputError, match="coincide"):
-        libvox.sdf((v, F), resolution=8)
+    for side, res in ((1, 4), (16, 64)):
+        v = V * side + 1e16
+        for kwargs in ({"fraction": True}, {"sdf": 3}):
+            with pytest.raises(libvox.InputError, match=r"coincide; use fewer cells") as e:
+                libvox.voxelize((v, F), resolution=res, **kwargs)
+            assert "\n" not in str(e.value)
+        with pytest.raises(libvox.InputError, match="coincide"):
+            libvox.sdf((v, F), resolution=res)
 
 
 def test_far_points_right_or_refused():

@@ -27,6 +27,7 @@ namespace {
 // field (libvox.sdf), Grid.distance at every cell centre, and the volume fractions.
 struct Answers {
   Grid grid;
+  std::vector<CellRun> solid, windingSolid;  // the flood fill's and the winding number's
   std::vector<double> dense, atCentres, closest, fractions;
   std::vector<int64_t> primitives;
 };
@@ -42,6 +43,10 @@ Answers answersFor(const Scene& scene) {
   storeSignedDistances(a.grid, scene, so, false);
   Grid filled = a.grid;
   fillSolid(filled, scene);
+  a.solid = filled.solidRuns;
+  Grid winding = a.grid;
+  fillSolid(winding, scene, fillForFractions({}));
+  a.windingSolid = winding.solidRuns;
   a.dense.resize(filled.cellCount());
   denseSignedDistances(filled, scene, a.dense, {1, filled.dims[0], uint64_t(filled.dims[0]) * filled.dims[1]});
   std::vector<double> points;
@@ -74,6 +79,14 @@ void expectAnswersScaled(const Answers& got, const Answers& unit, int k) {
   ASSERT_EQ(std::vector<uint64_t>(got.grid.cellKeys.begin(), got.grid.cellKeys.end()),
             std::vector<uint64_t>(unit.grid.cellKeys.begin(), unit.grid.cellKeys.end()))
       << k;
+  const auto runs = [](const std::vector<CellRun>& r) {
+    std::vector<uint64_t> out;
+    for (const CellRun& c : r) out.insert(out.end(), {c.first, c.count});
+    return out;
+  };
+  ASSERT_FALSE(unit.solid.empty());
+  ASSERT_EQ(runs(got.solid), runs(unit.solid)) << k;
+  ASSERT_EQ(runs(got.windingSolid), runs(unit.windingSolid)) << k;  // at 2^400 it once filled nothing
   ASSERT_EQ(got.grid.sdfKeys, unit.grid.sdfKeys) << k;
   expectScaled(got.grid.sdfValues, unit.grid.sdfValues, k, "band");
   expectScaled(got.dense, unit.dense, k, "dense");

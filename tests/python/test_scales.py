@@ -32,7 +32,7 @@ def answers(offset, k, tmp_path):
     back = libvox.load(tmp_path / "g.vgrid")
     for h in (back, pickle.loads(pickle.dumps(g))):
         assert np.array_equal(h.sdf[0], g.sdf[0]) and np.array_equal(h.sdf[1], g.sdf[1])
-        assert np.array_equal(h.fractions, g.fractions) and h.bounds == g.bounds
+        assert np.array_equal(h.fractions, g.fractions) and np.array_equal(h.bounds, g.bounds)
     with np.load(tmp_path / "g.npz") as z:
         assert np.array_equal(z["sdf"][tuple(g.sdf[0].T)], g.sdf[1])
     assert sorted(p.name for p in tmp_path.iterdir()) == ["g.npz", "g.vgrid"]  # no temporary left
@@ -46,7 +46,7 @@ def test_answers_scale_bit_for_bit(offset, tmp_path):
     assert (field1 < 0).any() and (g1.fractions > 0).any()
     for k in range(-1000, 1001, 50):
         g, field, d, prim, closest = answers(offset, k, tmp_path)
-        assert g.dims == g1.dims
+        assert g.dims == g1.dims and g.solid_count == g1.solid_count > 0  # the fill once gave up at 2^400
         assert np.array_equal(np.array(g.bounds), np.ldexp(np.array(g1.bounds), k))
         assert np.array_equal(g.sdf[0], g1.sdf[0])
         assert np.array_equal(g.sdf[1], np.ldexp(g1.sdf[1], k)), k

@@ -74,16 +74,23 @@ def test_huge_cube_band_inside_the_grid_and_saved(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["x.npz", "x.vgrid"]
 
 
-def test_coinciding_cell_boundaries_refused():
-    """Defect 9: a unit cube moved to 1e16 (cells of 1/8 where doubles are 2 apart) gave NaN fractions."""
-    for side, res in ((1, 4), (16, 64)):
-        v = V * side + 1e16
-        for kwargs in ({"fraction": True}, {"sdf": 3}):
-            with pytest.raises(libvox.InputError, match=r"coincide; use fewer cells") as e:
-                libvox.voxelize((v, F), resolution=res, **kwargs)
-            assert "\n" not in str(e.value)
-        with pytest.raises(libvox.InputError, match="coincide"):
-            libvox.sdf((v, F), resolution=res)
+def test_offset_1e16_right_or_refused(tmp_path):
+    """Defect 9: the unit cube moved to 1e16 gave 56 of 64 NaN fractions, which save wrote and load refused. There
+    1e16 + 1 rounds to 1e16: the cube is a point, with no volume, in cells wider than the doubles' spacing."""
+    v = V + 1e16
+    g = libvox.voxelize((v, F), resolution=4, sdf=3, fraction=True)
+    assert np.array_equal(g.fractions, np.zeros_like(g.fractions)) and np.isfinite(g.sdf[1]).all()
+    g.save(tmp_path / "p.vgrid")
+    assert np.array_equal(libvox.load(tmp_path / "p.vgrid").fractions, g.fractions)
+    assert np.array_equal(pickle.loads(pickle.dumps(g)).sdf[1], g.sdf[1])
+    # A cube of side 16 there in 64 cells: cells of 1/4 where doubles lie 2 apart, so boundaries coincide.
+    v = V * 16 + 1e16
+    for kwargs in ({"fraction": True}, {"sdf": 3}):
+        with pytest.raises(libvox.InputError, match=r"narrower than the spacing 2 of doubles at 1e\+16: cell") as e:
+            libvox.voxelize((v, F), resolution=64, **kwargs)
+        assert "\n" not in str(e.value)
+    with pytest.raises(libvox.InputError, match="coincide"):
+        libvox.sdf((v, F), resolution=64)
 
 
 def test_far_points_right_or_refused():

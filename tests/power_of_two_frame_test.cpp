@@ -233,8 +233,21 @@ TEST(PowerOfTwoFrame, FarPointsAreRightOrRefused) {
     denseSignedDistances(g, scene, field, {1, 4, 16});
     ADD_FAILURE() << "answered";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("sdf: bounds reach 1e+300"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("sdf: cell centres reach 7.5e+299 (bounds 1e+300)"), std::string::npos) << e.what();
   }
+}
+
+// Bounds of +-1e300 in one cell: its centre is on the scene, so the distance there is answered.
+TEST(PowerOfTwoFrame, OneHugeCellAboutTheSceneIsAnswered) {
+  const Scene scene = cube(-0.5, 0);
+  VoxelizeOptions vo;
+  vo.bounds = Box{{-1e300, -1e300, -1e300}, {1e300, 1e300, 1e300}};
+  vo.dims = std::array<uint32_t, 3>{1, 1, 1};
+  Grid g = voxelizeScene(scene, vo);
+  fillSolid(g, scene);
+  std::vector<double> field(1);
+  denseSignedDistances(g, scene, field, {1, 1, 1});
+  EXPECT_EQ(field[0], -0.5);
 }
 
 TEST(PowerOfTwoFrame, CoordinatesBeyond2Pow1020AreRefused) {

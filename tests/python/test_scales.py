@@ -102,5 +102,5 @@ def test_far_points_right_or_refused():
     for x in (1e300, -1e160):
         with pytest.raises(libvox.InputError, match=r"^points\[0, 1\] is .*within \+-1\.63669530394807"):
             g.distance([[0, x, 0]])
-    with pytest.raises(libvox.InputError, match=r"sdf: bounds reach 1e\+300"):
+    with pytest.raises(libvox.InputError, match=r"sdf: cell centres reach 7.5e\+299 \(bounds 1e\+300\)"):
         libvox.sdf((V, F), dims=(4, 4, 4), bounds=((-1e300,) * 3, (1e300,) * 3))

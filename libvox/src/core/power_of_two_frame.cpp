@@ -79,9 +79,16 @@ void checkNumericDomain(const Scene& scene, const Box& bounds, const std::array<
     checkCoordinate(bounds.lo[a], "the bounds'", what);
     checkCoordinate(bounds.hi[a], "the bounds'", what);
   }
-  if (checkReach && magnitude(frame.toFrame(bounds)) > std::ldexp(1.0, kFrameReachExponent))
-    fail<InputError>(what, ": bounds reach ", shortest(magnitude(bounds)), ", more than 2^", kFrameReachExponent,
-                     " times the scene's magnitude 2^", frame.exponent, ": distances are computed within +-",
+  // Distances are measured from cell centres (the outermost ones are the first and last of each axis): a single
+  // cell of 1e300 about a unit scene has its centre on the scene, and is answered.
+  double centres = 0;
+  for (int a = 0; a < 3; ++a)
+    centres = std::max({centres, std::fabs(cellCentreOnAxis(bounds, dims, a, 0)),
+                        std::fabs(cellCentreOnAxis(bounds, dims, a, dims[a] - 1))});
+  if (checkReach && frame.toFrame(centres) > std::ldexp(1.0, kFrameReachExponent))
+    fail<InputError>(what, ": cell centres reach ", shortest(centres), " (bounds ", shortest(magnitude(bounds)),
+                     "), more than 2^", kFrameReachExponent, " times the scene's magnitude 2^", frame.exponent,
+                     ": distances are computed within +-",
                      shortest(frame.toWorld(std::ldexp(1.0, kFrameReachExponent))), " for this scene");
   for (int a = 0; a < 3; ++a) {
     const double edge = (bounds.hi[a] - bounds.lo[a]) / dims[a];

@@ -18,7 +18,7 @@ namespace vox {
 // Coordinates (scene, bounds, query points) of distances and fractions lie within +-2^kMaxCoordinateExponent, so
 // that a distance across the grid (at most 2 sqrt(3) times the largest coordinate) never overflows.
 inline constexpr int kMaxCoordinateExponent = 1020;
-// Query points and grid bounds lie within +-2^kFrameReachExponent in the scene's frame (the scene's magnitude in
+// Query points and cell centres lie within +-2^kFrameReachExponent in the scene's frame (the scene's magnitude in
 // [1, 2)), so that squared distances never overflow (2^1000 < 2^1024).
 inline constexpr int kFrameReachExponent = 500;
 
@@ -52,8 +52,8 @@ PowerOfTwoFrame fractionFrame(const Scene& scene, const Box& bounds);
 Scene sceneInFrame(const Scene& scene, const PowerOfTwoFrame& frame);
 
 // Throws InputError, one line prefixed by `what`, when the grid cannot give exact-or-bounded distances, signs or
-// fractions in `frame`: a coordinate of the scene or the bounds beyond +-2^kMaxCoordinateExponent; bounds beyond
-// +-2^kFrameReachExponent in the frame (`checkReach`); a cell edge below the smallest normal double (cell
+// fractions in `frame`: a coordinate of the scene or the bounds beyond +-2^kMaxCoordinateExponent; cell centres
+// beyond +-2^kFrameReachExponent in the frame (`checkReach`); a cell edge below the smallest normal double (cell
 // boundaries would round unevenly); cell boundaries b(i) = lo + (hi - lo) * i / n that are not strictly increasing
 // (cells narrower than the coordinates' spacing: a unit cube moved to 1e16). Each message gives the allowed range.
 void checkNumericDomain(const Scene& scene, const Box& bounds, const std::array<uint32_t, 3>& dims,

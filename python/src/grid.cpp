@@ -185,6 +185,7 @@ py::object getState(const PyGrid& self) {
   std::string bytes;
   {
     py::gil_scoped_release release;
+    vox::checkGridBeforeWrite(self.grid(), self.source());  // no pickle that unpickling refuses
     bytes = vox::encodeGridFile(self.scene(), self.grid());
   }
   return py::make_tuple(py::bytes(bytes), sourceText(self));

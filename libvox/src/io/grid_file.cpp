@@ -241,7 +241,6 @@ void streamPayload(const Scene& scene, const Grid& grid, const EncodedCellTable&
 uint32_t gridFileVersionFor(const Grid& grid) { return grid.sdfHalfWidth > 0 || !grid.fractions.empty() ? 4 : 3; }
 
 std::string encodeGridFile(const Scene& scene, const Grid& grid, uint32_t version) {
-  checkGridBeforeWrite(grid, "grid file");
   if (version == 0) version = gridFileVersionFor(grid);
   if (version < gridFileVersionFor(grid) && version >= 3)
     fail<UsageError>("grid file version ", version, " cannot hold distances or volume fractions");

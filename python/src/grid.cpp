@@ -18,11 +18,11 @@ const vox::Accel& PyGrid::accel() {
 }
 
 const vox::NearestPrimitive& PyGrid::nearest() {
-  return nearest_.get([&] { return vox::NearestPrimitive(file_->scene); });
+  return nearest_.get([&] { return vox::NearestPrimitive(file_->scene, vox::sceneFrame(file_->scene)); });
 }
 
 const vox::InsideTest& PyGrid::insideTest() {
-  return insideTest_.get([&] { return vox::InsideTest(file_->scene); });
+  return insideTest_.get([&] { return vox::InsideTest(file_->scene, vox::sceneFrame(file_->scene)); });
 }
 
 namespace {
@@ -185,6 +185,7 @@ py::object getState(const PyGrid& self) {
   std::string bytes;
   {
     py::gil_scoped_release release;
+    vox::checkGridBeforeWrite(self.grid(), self.source());  // no pickle that unpickling refuses
     bytes = vox::encodeGridFile(self.scene(), self.grid());
   }
   return py::make_tuple(py::bytes(bytes), sourceText(self));

@@ -196,6 +196,7 @@ std::shared_ptr<PyGrid> voxelize(const py::object& source, const py::object& res
     return namedAfter(src, [&] {
       if (sdfHalfWidth) vo = vox::withCubicCells(scene, vo);  // as vox-voxelize --sdf: a level set's cubic cells
       if (doFractions) vox::checkVolumeFractionsPossible(scene, vo.method, vo.memoryLimitBytes);
+      vox::checkNumericDomainOfPlan(scene, vo, sdfHalfWidth.has_value(), doFractions);  // before any work
       vox::Grid g = vox::voxelizeScene(scene, vo);
       if (doFill) {
         vox::FillOptions fo;
@@ -248,6 +249,7 @@ py::array_t<double> denseSdf(const py::object& source, const py::object& resolut
       vo = vox::withCubicCells(scene, vo);
       // The dense array is refused before any work: the plan alone gives its size.
       vox::checkMemory(double(vox::planGrid(scene, vo).cellCount()) * 8, src.name, "sdf()");
+      vox::checkNumericDomainOfPlan(scene, vo, true, false);
       vox::Grid g = vox::voxelizeScene(scene, vo);
       std::vector<double> out(g.cellCount());  // signed by InsideTest: no fill needed
       const auto [nx, ny, nz] = g.dims;

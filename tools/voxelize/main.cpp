@@ -8,6 +8,7 @@
 #include "vox/core/error.h"
 #include "vox/core/progress.h"
 #include "vox/core/tool.h"
+#include "vox/distance/sdf.h"
 #include "vox/import/import.h"
 #include "vox/io/atomic_file.h"
 #include "vox/io/grid_file.h"
@@ -33,6 +34,7 @@ Grid voxelizeAndFill(const Options& opt, const Scene& scene, VoxelizeOptions vo,
   };
   try {
     if (opt.fraction) checkVolumeFractionsPossible(scene, vo.method, vo.memoryLimitBytes);  // before any work
+    checkNumericDomainOfPlan(scene, vo, opt.sdf.has_value(), opt.fraction);
     Grid grid = voxelizeScene(scene, vo, &stats);
     bar.finish();
     if (opt.fill) {

@@ -1,6 +1,7 @@
 #include "vox/core/grid.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "vox/core/cell_range.h"
 #include "vox/core/error.h"
@@ -96,6 +97,45 @@ void checkSolidRunsMissCells(std::span<const uint64_t> sortedKeys, const std::ve
       fail<InputError>(what, ": solid run ", r, " covers the occupied cell ", sortedKeys[c],
                        " (a cell is occupied or solid, not both)");
   }
+}
+
+namespace {
+
+// Keys strictly ascending and inside a grid of `cells` cells, or the index of the first that is not.
+size_t firstBadKey(std::span<const uint64_t> keys, uint64_t cells) {
+  for (size_t i = 0; i < keys.size(); ++i)
+    if (keys[i] >= cells || (i > 0 && keys[i] <= keys[i - 1])) return i;
+  return keys.size();
+}
+
+}  // namespace
+
+void checkGridBeforeWrite(const Grid& grid, const std::string& what) {
+  const uint64_t cells = grid.cellCount();
+  if (const size_t i = firstBadKey(grid.cellKeys, cells); i < grid.cellKeys.size())
+    fail<Error>(what, ": occupied cell key ", grid.cellKeys[i], " is repeated, out of order or outside the ", cells,
+                " cells; not written");
+  if (grid.cellStart.size() != grid.cellKeys.size() + 1 || grid.cellStart.back() != grid.primIds.size())
+    fail<Error>(what, ": the cell table's starts do not match its cells; not written");
+  checkSolidRuns(grid.solidRuns, cells, what);
+  if (grid.sdfKeys.size() != grid.sdfValues.size() || (grid.sdfHalfWidth == 0) != grid.sdfKeys.empty())
+    fail<Error>(what, ": the distance band has ", grid.sdfKeys.size(), " cells and ", grid.sdfValues.size(),
+                " values at half-width ", grid.sdfHalfWidth, "; not written");
+  if (grid.sdfHalfWidth != 0 && !(grid.sdfHalfWidth > 0 && grid.sdfHalfWidth <= 64))
+    fail<Error>(what, ": distance band half-width ", grid.sdfHalfWidth, " is outside (0, 64]; not written");
+  if (const size_t i = firstBadKey(grid.sdfKeys, cells); i < grid.sdfKeys.size())
+    fail<Error>(what, ": distance band cell key ", grid.sdfKeys[i], " is repeated, out of order or outside the ", cells,
+                " cells; not written");
+  for (size_t i = 0; i < grid.sdfValues.size(); ++i)
+    if (!std::isfinite(grid.sdfValues[i]))
+      fail<Error>(what, ": signed distance ", grid.sdfValues[i], " at cell key ", grid.sdfKeys[i], "; not written");
+  if (!grid.fractions.empty() && grid.fractions.size() != grid.cellKeys.size())
+    fail<Error>(what, ": ", grid.fractions.size(), " volume fractions for ", grid.cellKeys.size(),
+                " occupied cells; not written");
+  for (size_t c = 0; c < grid.fractions.size(); ++c)
+    if (!(grid.fractions[c] >= 0 && grid.fractions[c] <= 1))
+      fail<Error>(what, ": volume fraction ", grid.fractions[c], " at cell key ", grid.cellKeys[c],
+                  " is outside [0, 1]; not written");
 }
 
 std::array<int64_t, 2> cellRange(const Box& bounds, const std::array<uint32_t, 3>& dims, int axis, double lo,

@@ -68,6 +68,10 @@ InsideTest::InsideTest(const Scene& scene) {
   if (!order_.empty()) buildLineTree(0, uint32_t(order_.size()));
 }
 
+InsideTest::InsideTest(const Scene& scene, const PowerOfTwoFrame& frame) : InsideTest(sceneInFrame(scene, frame)) {
+  frame_ = frame;
+}
+
 // Median split of order_[begin, end) on the longer axis of the (y, z) centroids; depth first, so the first child
 // follows its parent.
 uint32_t InsideTest::buildLineTree(uint32_t begin, uint32_t end) {

@@ -43,6 +43,11 @@ void forHullPoints(const Scene& scene, const std::vector<Box>& boxes, uint32_t i
 
 }  // namespace
 
+NearestPrimitive::NearestPrimitive(const Scene& scene, const PowerOfTwoFrame& frame)
+    : NearestPrimitive(sceneInFrame(scene, frame)) {
+  frame_ = frame;
+}
+
 NearestPrimitive::NearestPrimitive(const Scene& scene) : triangleCount_(uint32_t(scene.triangles.size())) {
   const size_t n = scene.triangles.size() + scene.spheres.size();
   for (const Sphere& s : scene.spheres) shapes_.push_back(ellipsoidShape(s));

@@ -36,8 +36,32 @@ struct QueryProgress {
 
 }  // namespace
 
+namespace {
+
+void framedDenseSignedDistances(const Grid& grid, const Scene& scene, std::span<double> out,
+                                const std::array<uint64_t, 3>& strides, const DistanceQueryOptions& options);
+
+}  // namespace
+
+// Computed in the scene's power-of-two frame (docs/limits.md "Numeric domain"), as the band is, so the two agree bit
+// for bit at every scale.
 void denseSignedDistances(const Grid& grid, const Scene& scene, std::span<double> out,
                           const std::array<uint64_t, 3>& strides, const DistanceQueryOptions& options) {
+  const PowerOfTwoFrame frame = sceneFrame(scene);
+  checkNumericDomain(scene, grid.bounds, grid.dims, frame, true, "sdf");
+  if (frame.identity()) return framedDenseSignedDistances(grid, scene, out, strides, options);
+  Grid framed = grid;  // the cells and runs as they are, the bounds in the frame
+  framed.bounds = frame.toFrame(grid.bounds);
+  framedDenseSignedDistances(framed, sceneInFrame(scene, frame), out, strides, options);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, out.size(), 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i < r.end(); ++i) out[i] = frame.toWorld(out[i]);
+  });
+}
+
+namespace {
+
+void framedDenseSignedDistances(const Grid& grid, const Scene& scene, std::span<double> out,
+                                const std::array<uint64_t, 3>& strides, const DistanceQueryOptions& options) {
   const NearestPrimitive nearest(scene);
   std::function<bool(double)> signProgress;
   if (options.progress) signProgress = [&](double f) { return options.progress(0.1 * f); };
@@ -94,8 +118,6 @@ void denseSignedDistances(const Grid& grid, const Scene& scene, std::span<double
   if (progress.cancelled) fail<Error>("signed distances cancelled");
 }
 
-namespace {
-
 // The points' indices in Morton order of their positions quantized to 2^21 steps per axis over their bounding box:
 // consecutive points are then near each other, so each one's search can start from the one before's answer.
 std::vector<uint32_t> spatialOrder(std::span<const double> points) {
@@ -130,18 +152,21 @@ std::vector<uint32_t> spatialOrder(std::span<const double> points) {
   return order;
 }
 
-void checkPoints(std::span<const double> points) {
+void checkPoints(std::span<const double> points, const PowerOfTwoFrame& frame) {
   for (size_t i = 0; i < points.size(); ++i)
     if (!std::isfinite(points[i]))
       fail<InputError>("points[", i / 3, ", ", i % 3, "] is ", points[i], ": coordinates must be finite");
+  checkPointsInDomain(points, frame);
   if (points.size() / 3 > UINT32_MAX)
     fail<LimitError>("point distances: ", points.size() / 3, " points, more than 2^32 - 1 in one call");
 }
 
-// pointDistances after checkPoints.
+// pointDistances after checkPoints. Each point is scaled into the search's frame and its answer back out of it.
 void checkedPointDistances(const NearestPrimitive& nearest, const InsideTest* insideTest,
                            std::span<const double> points, const PointDistanceOutput& out,
                            const DistanceQueryOptions& options) {
+  VOX_CHECK(!insideTest || insideTest->frame() == nearest.frame());
+  const PowerOfTwoFrame& frame = nearest.frame();
   const size_t n = points.size() / 3;
   const std::vector<uint32_t> order = spatialOrder(points);
   QueryProgress progress{options, n};
@@ -151,11 +176,11 @@ void checkedPointDistances(const NearestPrimitive& nearest, const InsideTest* in
     int64_t previous = -1;
     for (size_t k = r.begin(); k < r.end(); ++k) {
       const size_t i = order[k];
-      const Vec3 p{points[3 * i], points[3 * i + 1], points[3 * i + 2]};
+      const Vec3 p = frame.toFrame(Vec3{points[3 * i], points[3 * i + 1], points[3 * i + 2]});
       const NearestHit hit = nearest.nearestFrom(p, previous);
       previous = hit.primitive;
-      const double d = std::sqrt(hit.squaredDistance);
-      const Vec3 c = nearest.closestPoint(hit.primitive, p);
+      const double d = frame.toWorld(std::sqrt(hit.squaredDistance));
+      const Vec3 c = frame.toWorld(nearest.closestPoint(hit.primitive, p));
       out.distance[i] = insideTest && d > 0 && insideTest->inside(p) ? -d : d;
       out.primitive[i] = hit.primitive;
       for (int a = 0; a < 3; ++a) out.closest[3 * i + a] = c[a];
@@ -169,16 +194,17 @@ void checkedPointDistances(const NearestPrimitive& nearest, const InsideTest* in
 
 void pointDistances(const Scene& scene, std::span<const double> points, bool signedDistance,
                     const PointDistanceOutput& out, const DistanceQueryOptions& options) {
-  checkPoints(points);  // before the structures are built
-  const NearestPrimitive nearest(scene);
+  const PowerOfTwoFrame frame = sceneFrame(scene);
+  checkPoints(points, frame);  // before the structures are built
+  const NearestPrimitive nearest(scene, frame);
   std::optional<InsideTest> insideTest;
-  if (signedDistance) insideTest.emplace(scene);
+  if (signedDistance) insideTest.emplace(scene, frame);
   checkedPointDistances(nearest, insideTest ? &*insideTest : nullptr, points, out, options);
 }
 
 void pointDistances(const NearestPrimitive& nearest, const InsideTest* insideTest, std::span<const double> points,
                     const PointDistanceOutput& out, const DistanceQueryOptions& options) {
-  checkPoints(points);
+  checkPoints(points, nearest.frame());
   checkedPointDistances(nearest, insideTest, points, out, options);
 }
 

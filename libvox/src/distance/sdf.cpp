@@ -153,10 +153,15 @@ std::vector<std::vector<Candidate>> bandCandidates(const Grid& grid, const Scene
               if (d2 < slot) slot = d2;
             }
       }
-      for (uint32_t k = 0; k < kTile; ++k)
-        for (uint32_t j = 0; j < kTile; ++j)
-          for (uint32_t i = 0; i < kTile; ++i) {
-            const double d2 = nearest[i + kTile * (j + kTile * k)];
+      // Only the tile's cells inside the grid: an edge tile's others keep +infinity, which a reach that
+      // overflowed to +infinity would once have let through as keys past the grid (issue 45).
+      const int64_t end[3] = {std::min<int64_t>(kTile, int64_t(grid.dims[0]) - t0[0]),
+                              std::min<int64_t>(kTile, int64_t(grid.dims[1]) - t0[1]),
+                              std::min<int64_t>(kTile, int64_t(grid.dims[2]) - t0[2])};
+      for (int64_t k = 0; k < end[2]; ++k)
+        for (int64_t j = 0; j < end[1]; ++j)
+          for (int64_t i = 0; i < end[0]; ++i) {
+            const double d2 = nearest[size_t(i + kTile * (j + kTile * k))];
             if (d2 <= reach2) out.push_back({cellKey(grid.dims, t0[0] + i, t0[1] + j, t0[2] + k), d2});
           }
       if ((emitted += out.size() - before) > maxCells) overBudget = true;
@@ -178,6 +183,10 @@ std::vector<std::vector<Candidate>> bandCandidates(const Grid& grid, const Scene
 SdfBand signedDistanceBand(const Grid& grid, const Scene& scene, const SdfOptions& options) {
   checkSdfHalfWidth(options.halfWidth, "--sdf");
   const double reach = options.halfWidth * smallestCellEdge(grid);
+  // Squared distances are compared with reach^2: an overflow would take every cell (storeSignedDistances works in
+  // a frame where it cannot).
+  if (!std::isfinite(reach * reach))
+    fail<InputError>("--sdf: the band's reach ", reach, " squared overflows; scale the scene nearer 1");
   std::vector<std::vector<Candidate>> pieces = bandCandidates(grid, scene, reach, options);
   size_t total = 0;
   for (const auto& piece : pieces) total += piece.size();
@@ -226,12 +235,60 @@ VoxelizeOptions withCubicCells(const Scene& scene, VoxelizeOptions options) {
   return options;
 }
 
-void storeSignedDistances(Grid& grid, const Scene& scene, const SdfOptions& options, bool /*filled*/) {
+void checkNumericDomainOfPlan(const Scene& scene, const VoxelizeOptions& options, bool signedDistances,
+                              bool fractions) {
+  if (!signedDistances && !fractions) return;
+  const Grid plan = planGrid(scene, options);
+  if (signedDistances) checkNumericDomain(scene, plan.bounds, plan.dims, sceneFrame(scene), true, "--sdf");
+  if (fractions)
+    checkNumericDomain(scene, plan.bounds, plan.dims, fractionFrame(scene, plan.bounds), false, "volume fractions");
+}
+
+namespace {
+
+// The grid's bounds scaled into a frame for the span of a computation, and back whatever happens.
+class FramedBounds {
+ public:
+  FramedBounds(Grid& grid, const PowerOfTwoFrame& frame) : grid_(grid), world_(grid.bounds) {
+    grid.bounds = frame.toFrame(world_);
+  }
+  ~FramedBounds() { grid_.bounds = world_; }
+  FramedBounds(const FramedBounds&) = delete;
+  FramedBounds& operator=(const FramedBounds&) = delete;
+
+ private:
+  Grid& grid_;
+  Box world_;
+};
+
+void storeFramedSignedDistances(Grid& grid, const Scene& scene, const SdfOptions& options, bool filled);
+
+}  // namespace
+
+// The band is computed in the scene's power-of-two frame (docs/limits.md "Numeric domain"): a scene's band at scale
+// 2^k is its band at scale 1 times 2^k, bit for bit, and no squared distance overflows or underflows.
+void storeSignedDistances(Grid& grid, const Scene& scene, const SdfOptions& options, bool filled) {
+  checkSdfHalfWidth(options.halfWidth, "--sdf");
+  const PowerOfTwoFrame frame = sceneFrame(scene);
+  checkNumericDomain(scene, grid.bounds, grid.dims, frame, true, "--sdf");
+  if (frame.identity()) return storeFramedSignedDistances(grid, scene, options, filled);
+  {
+    const FramedBounds framed(grid, frame);
+    storeFramedSignedDistances(grid, sceneInFrame(scene, frame), options, filled);
+  }
+  for (double& v : grid.sdfValues) v = frame.toWorld(v);
+}
+
+namespace {
+
+void storeFramedSignedDistances(Grid& grid, const Scene& scene, const SdfOptions& options, bool /*filled*/) {
   // The signs come from InsideTest, not from the fill: nothing to fill on the side.
   SdfBand band = signedDistanceBand(grid, scene, options);
   grid.sdfHalfWidth = options.halfWidth;
   grid.sdfKeys = std::move(band.keys);
   grid.sdfValues = std::move(band.values);
 }
+
+}  // namespace
 
 }  // namespace vox

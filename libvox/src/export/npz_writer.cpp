@@ -123,6 +123,9 @@ void addArray(ZipWriter& zip, const char* name, const char* descr, const std::ve
 }  // namespace
 
 uint64_t writeNpz(std::ostream& out, const Grid& grid, const std::function<void(double)>& progress) {
+  // Every key below indexes a dense array of cellCount() entries: checked first, so that no grid, however it was
+  // made, writes out of bounds (issue 45: a band with keys past the grid overflowed the heap).
+  checkGridBeforeWrite(grid, "npz export");
   const uint64_t cells = grid.cellCount();
   const bool sdf = grid.sdfHalfWidth > 0, fraction = !grid.fractions.empty();
   const uint64_t total = cells * (2 + (sdf ? 8 : 0) + (fraction ? 8 : 0)) + 4096;

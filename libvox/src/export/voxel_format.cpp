@@ -79,6 +79,7 @@ std::optional<VoxelFormat> voxelFormatFromPath(const std::string& path) {
 VoxelFileReport writeVoxelFile(const std::string& path, VoxelFormat format, const Grid& grid,
                                std::span<const Rgb8> cellColors, const std::function<void(double)>& progress) {
   VoxelFileReport report;
+  checkGridBeforeWrite(grid, path);  // before the output is opened (writeNpz checks again, for its other callers)
   OutputFile file(path);
   switch (format) {
     case VoxelFormat::Binvox:

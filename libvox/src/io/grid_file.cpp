@@ -442,6 +442,7 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
 void writeGridFile(const std::string& path, const Scene& scene, const Grid& grid, WriteTimes* times) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
+  checkGridBeforeWrite(grid, path);  // before the output is opened: nothing is written that a reader refuses
   // Three passes over the encoding instead of the whole file in memory (at 1024^3 the file is as large as the grid):
   // the size, which seeds the checksum; the checksum; then the bytes, header first, through a temporary file.
   // The cell table, the bulk of the file, is encoded once.

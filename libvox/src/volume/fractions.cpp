@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "vox/core/error.h"
+#include "vox/core/power_of_two_frame.h"
 #include "vox/voxelize/open_edges.h"
 #include "volume/ball_box.h"
 #include "volume/mesh_cell_volume.h"
@@ -311,8 +312,40 @@ FillOptions fillForFractions(FillOptions options) {
   return options;
 }
 
+namespace {
+
+std::vector<double> framedVolumeFractions(const Grid& grid, const Scene& scene, const FractionOptions& options);
+
+}  // namespace
+
+// Computed in the power-of-two frame of the scene and the bounds together (docs/limits.md "Numeric domain"): cell
+// volumes and the integrals' products neither overflow at 1e120 nor underflow at 1e-120, and a scene's fractions
+// at scale 2^k equal its fractions at scale 1.
 std::vector<double> volumeFractions(const Grid& grid, const Scene& scene, const FractionOptions& options) {
   checkVolumeFractionsPossible(scene, grid.method, options.memoryLimitBytes);
+  const PowerOfTwoFrame frame = fractionFrame(scene, grid.bounds);
+  checkNumericDomain(scene, grid.bounds, grid.dims, frame, false, "volume fractions");
+  std::vector<double> fractions;
+  if (frame.identity()) {
+    fractions = framedVolumeFractions(grid, scene, options);
+  } else {
+    Grid framed = grid;  // the cells as they are, the bounds in the frame
+    framed.bounds = frame.toFrame(grid.bounds);
+    fractions = framedVolumeFractions(framed, sceneInFrame(scene, frame), options);
+  }
+  // The grid file's reader refuses anything else: refuse it here, before a file is written (issue 45).
+  for (size_t c = 0; c < fractions.size(); ++c)
+    if (!(fractions[c] >= 0 && fractions[c] <= 1)) {
+      const auto ijk = cellIndex(grid.dims, grid.cellKeys[c]);
+      fail<InputError>("volume fractions: cell (", ijk[0], ", ", ijk[1], ", ", ijk[2], ") got ", fractions[c],
+                       ": the scene lies outside the numeric domain of docs/limits.md");
+    }
+  return fractions;
+}
+
+namespace {
+
+std::vector<double> framedVolumeFractions(const Grid& grid, const Scene& scene, const FractionOptions& options) {
   const std::vector<Ball> balls = ballsOf(scene);
   Progress progress{options};
   const size_t nTri = scene.triangles.size();
@@ -376,5 +409,7 @@ std::vector<double> volumeFractions(const Grid& grid, const Scene& scene, const 
   }
   return fractions;
 }
+
+}  // namespace
 
 }  // namespace vox

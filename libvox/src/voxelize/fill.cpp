@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cfloat>
 #include <memory>
 #include <cmath>
 #include <limits>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "vox/core/error.h"
+#include "vox/core/power_of_two_frame.h"
 #include "vox/core/resize_in_steps.h"
 #include "vox/voxelize/open_edges.h"
 #include "vox/voxelize/overlap.h"
@@ -751,7 +753,29 @@ SlabLinks linkSlab(Grid&& grid, uint32_t k0, uint32_t k1, uint64_t memoryLimitBy
 }
 }  // namespace
 
+static FillReport framedFillSolid(Grid& grid, const Scene& scene, const FillOptions& options);
+
+// The winding numbers in the power-of-two frame of the scene and the bounds (docs/limits.md "Numeric domain"):
+// at 2^400 their products overflowed and nothing was filled. Cells of subnormal width stay in world units, where
+// their boundaries are computed (the frame would round them differently).
 FillReport fillSolid(Grid& grid, const Scene& scene, const FillOptions& options) {
+  const PowerOfTwoFrame frame = fractionFrame(scene, grid.bounds);
+  bool useFrame = !frame.identity();
+  for (int a = 0; a < 3; ++a) useFrame = useFrame && (grid.bounds.hi[a] - grid.bounds.lo[a]) / grid.dims[a] >= DBL_MIN;
+  if (!useFrame) return framedFillSolid(grid, scene, options);
+  const Box world = grid.bounds;
+  grid.bounds = frame.toFrame(world);
+  try {
+    const FillReport report = framedFillSolid(grid, sceneInFrame(scene, frame), options);
+    grid.bounds = world;
+    return report;
+  } catch (...) {
+    grid.bounds = world;
+    throw;
+  }
+}
+
+static FillReport framedFillSolid(Grid& grid, const Scene& scene, const FillOptions& options) {
   std::shared_ptr<const FillWinding> winding;
   const CancelCheck check{&options, 0};
   check();

@@ -103,6 +103,13 @@ void checkSolidRuns(const std::vector<CellRun>& runs, uint64_t cellCount, const 
 void checkSolidRunsMissCells(std::span<const uint64_t> sortedKeys, const std::vector<CellRun>& runs,
                              const std::string& what);
 
+// Throws vox::Error naming `what` ("... not written") unless the grid holds what every reader accepts: occupied
+// keys strictly ascending inside the grid with their cell starts, solid runs as checkSolidRuns wants them, a band
+// of strictly ascending keys inside the grid with one finite value each and a half-width in (0, 64], and one
+// fraction in [0, 1] per occupied cell. Writers call it before opening their output, so that no file is ever
+// written that a reader would refuse, and no dense array is indexed by a key past its end. O(cells stored).
+void checkGridBeforeWrite(const Grid& grid, const std::string& what);
+
 // Smallest index range [first, last] of cells on `axis` whose closed boxes meet [lo, hi] (clamped to the grid);
 // uses cellBoundary, so a coordinate exactly on a boundary yields both neighbouring cells. first > last when the
 // interval misses the grid.

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "vox/core/math.h"
+#include "vox/core/power_of_two_frame.h"
 #include "vox/core/scene.h"
 #include "vox/distance/closest_point.h"
 
@@ -24,6 +25,10 @@ class NearestPrimitive {
   // Copies what it needs from `scene` (about 270 bytes per primitive, with the nodes). Throws InputError for a singular
   // sphere transform (ellipsoidShape).
   explicit NearestPrimitive(const Scene& scene);
+  // The same over the scene scaled into `frame` (vox/core/power_of_two_frame.h): points given to the queries below
+  // and the distances and points they return are then in that frame.
+  NearestPrimitive(const Scene& scene, const PowerOfTwoFrame& frame);
+  const PowerOfTwoFrame& frame() const { return frame_; }
 
   // The primitive nearest to p, ties to the lowest id. `bound2`: a squared distance the caller knows the answer does
   // not exceed, which prunes the search; subtrees and primitives farther than it are skipped, so a bound below the
@@ -66,6 +71,7 @@ class NearestPrimitive {
   std::vector<TriangleLowerBound> bounds_;  // by slot, of triangles
   std::vector<EllipsoidShape> shapes_;      // by sphere index
   uint32_t triangleCount_ = 0;
+  PowerOfTwoFrame frame_;
 };
 
 }  // namespace vox

@@ -11,6 +11,7 @@
 
 #include "vox/core/grid.h"
 #include "vox/core/math.h"
+#include "vox/core/power_of_two_frame.h"
 #include "vox/core/scene.h"
 #include "vox/distance/closest_point.h"
 #include "vox/voxelize/open_edges.h"
@@ -50,7 +51,11 @@ struct SdfBand {
 class InsideTest {
  public:
   explicit InsideTest(const Scene& scene);
+  // The same over the scene scaled into `frame` (vox/core/power_of_two_frame.h): `inside` then takes points in
+  // that frame, where winding numbers of a scene at 1e-300 or 1e300 neither underflow nor overflow.
+  InsideTest(const Scene& scene, const PowerOfTwoFrame& frame);
   bool inside(const Vec3& p) const;
+  const PowerOfTwoFrame& frame() const { return frame_; }
 
   // A crossing of a row line with a triangle (index into the test's triangles: the mesh's, then the caps').
   struct Crossing {
@@ -79,6 +84,7 @@ class InsideTest {
   WindingTree tree_;     // a soup's
   WindingTree capTree_;  // the caps'
   std::vector<EllipsoidShape> shapes_;
+  PowerOfTwoFrame frame_;
 };
 
 // Check of a --sdf half-width: finite, > 0, <= kMaxSdfHalfWidth; throws UsageError naming `what` otherwise.
@@ -95,6 +101,11 @@ SdfBand signedDistanceBand(const Grid& grid, const Scene& scene, const SdfOption
 // scene's (by less than a cell on each shorter axis) so that every cell has the longest axis' edge, as an OpenVDB
 // level set needs (vox-export .vdb). Options with dims or bounds are returned unchanged. Throws as planGrid.
 VoxelizeOptions withCubicCells(const Scene& scene, VoxelizeOptions options);
+
+// The numeric domain checks of storeSignedDistances (`signedDistances`), denseSignedDistances (the same) and
+// volumeFractions (`fractions`) on the grid `options` plan for `scene`, for tools to refuse before voxelizing.
+// Throws InputError with one line (checkNumericDomain), or as planGrid.
+void checkNumericDomainOfPlan(const Scene& scene, const VoxelizeOptions& options, bool signedDistances, bool fractions);
 
 // signedDistanceBand stored in `grid` (sdfHalfWidth, sdfKeys, sdfValues), what vox-voxelize --sdf and
 // libvox.voxelize(sdf=) do. `filled` is kept for callers: the signs no longer need the fill.

@@ -43,7 +43,8 @@ uint64_t gridChecksum(const char* payload, size_t size);
 // The same on bytes in memory (fuzzing, tests). `name` is used in error messages. `version` 2 writes the previous
 // layout, for tests that old files still read. The grid must be well-formed (every cell's offsets inside primIds,
 // as voxelizeScene and decodeGridFile make it): version 3's encoder reads each cell's ids. Version 0: the one
-// gridFileVersionFor names.
+// gridFileVersionFor names. It encodes what it is given (tests make bad files with it); the writers of real
+// output (writeGridFile, pickling) call checkGridBeforeWrite first.
 std::string encodeGridFile(const Scene& scene, const Grid& grid, uint32_t version = 0);
 GridFile decodeGridFile(const std::string& bytes, const std::string& name);
 

@@ -96,6 +96,7 @@ void save(PyGrid& self, const py::object& pathObj, const py::object& facesName, 
       vox::ViewerPageOptions options;
       options.color = color;
       options.title = std::filesystem::path(self.source()).filename().string();  // as vox-export: the grid's name
+      options.progress = [&](double f) { return interrupt.poll(f); };
       vox::writeViewerPage(*path, grid, self.scene(), options);
     } else if (voxelFormat) {
       std::vector<vox::Rgb8> colors;

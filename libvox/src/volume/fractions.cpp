@@ -91,6 +91,14 @@ struct Progress {
   }
 };
 
+// tbb::parallel_for over [0, n) in blocks of at most `grain` items (simple_partitioner), each reporting when done:
+// the default partitioner hands a thread a whole share of the items, and Ctrl-C waited 6 to 11 s during the
+// fractions of a large ball.
+template <typename Body>
+void forBlocks(size_t n, size_t grain, const Body& body) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, grain), body, tbb::simple_partitioner());
+}
+
 struct Crossing {
   double z;  // relative to grid.bounds.lo.z
   int32_t jump;
@@ -206,42 +214,37 @@ LineTable buildLines(const Grid& grid, const Scene& scene, const FractionOptions
   std::vector<size_t> counts(table.keys.size());
   std::atomic<int> minW{0}, maxW{0};
   std::atomic<bool> unclosed{false};
-  // simple_partitioner: blocks of at most 256 lines, each reporting when done; the default partitioner hands a
-  // thread ranges of a whole share of the lines, with no report for seconds.
-  tbb::parallel_for(
-      tbb::blocked_range<size_t>(0, table.keys.size(), 256),
-      [&](const auto& r) {
-        if (progress.cancelled) return;
-        for (size_t g = r.begin(); g < r.end(); ++g) {
-          const double X = cellBoundary(grid.bounds, grid.dims, 0, int64_t(table.keys[g] % nx1));
-          const double Y = cellBoundary(grid.bounds, grid.dims, 1, int64_t(table.keys[g] / nx1));
-          Crossing* out = table.crossings.data() + table.start[g];
-          size_t n = 0;
-          std::vector<uint32_t>& prims = scratch.local();
-          linePrims(grid, scene, columns, table.keys[g], prims);
-          for (const uint32_t p : prims)
-            if (const auto c = volume::lineCrossing(scene.triangles[p], X, Y, grid.bounds.lo.z))
-              out[n++] = {c->z, c->jump, 0};
-          std::sort(out, out + n);
-          int w = 0, lo = 0, hi = 0;
-          for (size_t i = 0; i < n; ++i) {
-            out[i].after = w += out[i].jump;
-            // Only between distinct heights: crossings at one z (a vertex on the line, touching shells) bound an
-            // interval of length 0, whose w does not count.
-            if (i + 1 < n && out[i + 1].z == out[i].z) continue;
-            lo = std::min(lo, w);
-            hi = std::max(hi, w);
-          }
-          counts[g] = n;
-          if (w != 0) unclosed = true;
-          for (int m = minW; lo < m && !minW.compare_exchange_weak(m, lo);) {
-          }
-          for (int m = maxW; hi > m && !maxW.compare_exchange_weak(m, hi);) {
-          }
-        }
-        progress.report(0, 0.3, r.size(), table.keys.size());
-      },
-      tbb::simple_partitioner());
+  forBlocks(table.keys.size(), 256, [&](const auto& r) {
+    if (progress.cancelled) return;
+    for (size_t g = r.begin(); g < r.end(); ++g) {
+      const double X = cellBoundary(grid.bounds, grid.dims, 0, int64_t(table.keys[g] % nx1));
+      const double Y = cellBoundary(grid.bounds, grid.dims, 1, int64_t(table.keys[g] / nx1));
+      Crossing* out = table.crossings.data() + table.start[g];
+      size_t n = 0;
+      std::vector<uint32_t>& prims = scratch.local();
+      linePrims(grid, scene, columns, table.keys[g], prims);
+      for (const uint32_t p : prims)
+        if (const auto c = volume::lineCrossing(scene.triangles[p], X, Y, grid.bounds.lo.z))
+          out[n++] = {c->z, c->jump, 0};
+      std::sort(out, out + n);
+      int w = 0, lo = 0, hi = 0;
+      for (size_t i = 0; i < n; ++i) {
+        out[i].after = w += out[i].jump;
+        // Only between distinct heights: crossings at one z (a vertex on the line, touching shells) bound an
+        // interval of length 0, whose w does not count.
+        if (i + 1 < n && out[i + 1].z == out[i].z) continue;
+        lo = std::min(lo, w);
+        hi = std::max(hi, w);
+      }
+      counts[g] = n;
+      if (w != 0) unclosed = true;
+      for (int m = minW; lo < m && !minW.compare_exchange_weak(m, lo);) {
+      }
+      for (int m = maxW; hi > m && !maxW.compare_exchange_weak(m, hi);) {
+      }
+    }
+    progress.report(0, 0.3, r.size(), table.keys.size());
+  });
   progress.check();
   // Compact: each line keeps only the triangles that cross it.
   size_t used = 0;
@@ -337,46 +340,42 @@ std::vector<double> volumeFractions(const Grid& grid, const Scene& scene, const 
   const uint64_t nx1 = uint64_t(grid.dims[0]) + 1;
   std::vector<double> fractions(grid.cellKeys.size());
   Conflict conflict;
-  // Blocks of at most 64 cells (simple_partitioner), each reporting when done: a cell cut by a ball costs up to a
-  // few hundred microseconds of quadrature, and the default partitioner's ranges ran for seconds without a report.
-  tbb::parallel_for(
-      tbb::blocked_range<size_t>(0, grid.cellKeys.size(), 64),
-      [&](const auto& r) {
-        if (progress.cancelled) return;
-        std::vector<const Triangle*> tris;
-        std::vector<uint32_t> cellBalls;
-        for (size_t c = r.begin(); c < r.end(); ++c) {
-          const auto ijk = cellIndex(grid.dims, grid.cellKeys[c]);
-          const Box box = cellBox(grid, ijk[0], ijk[1], ijk[2]);
-          const CellPlanes planes{{box.lo.x, box.lo.y, box.lo.z}, {box.hi.x, box.hi.y, box.hi.z}};
-          tris.clear();
-          cellBalls.clear();
-          for (const uint32_t p : grid.cellPrims(c))
-            if (p < nTri)
-              tris.push_back(&scene.triangles[p]);
-            else if (p - nTri < balls.size())
-              cellBalls.push_back(uint32_t(p - nTri));
-          double v = 0;
-          if (nTri > 0) {
-            const uint64_t key = (uint64_t(ijk[0]) + 1) + nx1 * (uint64_t(ijk[1]) + 1);
-            const double edge = edgeIntegral(lines, key, box.lo.z - grid.bounds.lo.z, box.hi.z - grid.bounds.lo.z);
-            v = orientation * volume::cellMeshVolume(tris, planes, edge);
-          }
-          if (!cellBalls.empty() && (!tris.empty() || v != 0)) conflict.note(c);
-          for (size_t i = 0; i < cellBalls.size(); ++i) {
-            const Ball& b = balls[cellBalls[i]];
-            for (size_t j = 0; j < i; ++j) {
-              const Ball& o = balls[cellBalls[j]];
-              if (length(b.center - o.center) < b.radius + o.radius) conflict.note(c);
-            }
-            v += volume::ballBoxVolume(b.center, b.radius, box);
-          }
-          const double cellVolume = (box.hi.x - box.lo.x) * (box.hi.y - box.lo.y) * (box.hi.z - box.lo.z);
-          fractions[c] = std::clamp(v / cellVolume, 0.0, 1.0);
+  // Blocks of 64 cells: a cell cut by a ball costs up to a few hundred microseconds of quadrature.
+  forBlocks(grid.cellKeys.size(), 64, [&](const auto& r) {
+    if (progress.cancelled) return;
+    std::vector<const Triangle*> tris;
+    std::vector<uint32_t> cellBalls;
+    for (size_t c = r.begin(); c < r.end(); ++c) {
+      const auto ijk = cellIndex(grid.dims, grid.cellKeys[c]);
+      const Box box = cellBox(grid, ijk[0], ijk[1], ijk[2]);
+      const CellPlanes planes{{box.lo.x, box.lo.y, box.lo.z}, {box.hi.x, box.hi.y, box.hi.z}};
+      tris.clear();
+      cellBalls.clear();
+      for (const uint32_t p : grid.cellPrims(c))
+        if (p < nTri)
+          tris.push_back(&scene.triangles[p]);
+        else if (p - nTri < balls.size())
+          cellBalls.push_back(uint32_t(p - nTri));
+      double v = 0;
+      if (nTri > 0) {
+        const uint64_t key = (uint64_t(ijk[0]) + 1) + nx1 * (uint64_t(ijk[1]) + 1);
+        const double edge = edgeIntegral(lines, key, box.lo.z - grid.bounds.lo.z, box.hi.z - grid.bounds.lo.z);
+        v = orientation * volume::cellMeshVolume(tris, planes, edge);
+      }
+      if (!cellBalls.empty() && (!tris.empty() || v != 0)) conflict.note(c);
+      for (size_t i = 0; i < cellBalls.size(); ++i) {
+        const Ball& b = balls[cellBalls[i]];
+        for (size_t j = 0; j < i; ++j) {
+          const Ball& o = balls[cellBalls[j]];
+          if (length(b.center - o.center) < b.radius + o.radius) conflict.note(c);
         }
-        progress.report(0.3, 0.7, r.size(), grid.cellKeys.size());
-      },
-      tbb::simple_partitioner());
+        v += volume::ballBoxVolume(b.center, b.radius, box);
+      }
+      const double cellVolume = (box.hi.x - box.lo.x) * (box.hi.y - box.lo.y) * (box.hi.z - box.lo.z);
+      fractions[c] = std::clamp(v / cellVolume, 0.0, 1.0);
+    }
+    progress.report(0.3, 0.7, r.size(), grid.cellKeys.size());
+  });
   progress.check();
   if (conflict.cell != UINT64_MAX) {
     const auto ijk = cellIndex(grid.dims, grid.cellKeys[conflict.cell]);

@@ -155,9 +155,9 @@ def _rays(grid, count):
     return origins, targets - origins
 
 
-def _save(resolution, ext, **kw):
+def _save(resolution, ext, fill=False, **kw):
     def make(folder, bunny):
-        grid = _bunny_grid(bunny, resolution)
+        grid = _bunny_grid(bunny, resolution, fill=fill)
         out = folder / f"out{ext}"
         return (lambda: grid.save(out, **kw)), out
     return make
@@ -290,7 +290,7 @@ CASES = {
     "read_ply": _setup_read(big_ply, 3_000_000),
     "read_gltf": _setup_read(big_glb, 6_000_000),
     "read_course": _setup_read_course,
-    "save_vgrid": _save(2048, ".vgrid"),
+    "save_vgrid": _save(2048, ".vgrid", fill=True),
     "save_bricks": _save(1024, ".vgrid", bricks=(2, 2, 2)),
     "save_ply": _save(512, ".ply"),
     "save_obj": _save(512, ".obj"),
@@ -298,10 +298,10 @@ CASES = {
     "save_stl": _save(512, ".stl"),
     "save_glb": _save(512, ".glb"),
     "save_gltf": _save(512, ".gltf"),
-    "save_binvox": _save(2048, ".binvox"),
-    "save_vox": _save(1024, ".vox"),
-    "save_vdb": _save(2048, ".vdb"),
-    "save_npz": _save(2048, ".npz"),
+    "save_binvox": _save(2048, ".binvox", fill=True),
+    "save_vox": _save(2048, ".vox"),
+    "save_vdb": _save(1024, ".vdb"),
+    "save_npz": _save(768, ".npz"),
     "save_html": _save(256, ".html"),
 }
 

@@ -181,6 +181,12 @@ def _setup_big_ball_fractions(folder, bunny):
     return lambda: libvox.voxelize(scene, resolution=120, fraction=True), None
 
 
+def _setup_big_ball(folder, bunny):
+    """One ball is one primitive: its cell loop, 1.6 * 10^7 cells here, ran to its end before Ctrl-C acted."""
+    scene = ball_scene(folder, 1)
+    return lambda: libvox.voxelize(scene, resolution=250), None
+
+
 def _setup_mesh_fractions(folder, bunny):
     v, f = icosphere(4)
     return lambda: libvox.voxelize((v, f), resolution=450, fraction=True), None
@@ -273,6 +279,7 @@ CASES = {
     "fill": _setup_fill,
     "ball_fractions": _setup_ball_fractions,
     "big_ball_fractions": _setup_big_ball_fractions,
+    "big_ball": _setup_big_ball,
     "mesh_fractions": _setup_mesh_fractions,
     "sdf_band": _setup_sdf_band,
     "sdf_dense": _setup_sdf_dense,
@@ -286,8 +293,8 @@ CASES = {
     "load": _setup_load,
     "pickle": _setup_pickle,
     "unpickle": _setup_unpickle,
-    "read_obj": _setup_read(big_obj, 6_000_000),
-    "read_ply": _setup_read(big_ply, 3_000_000),
+    "read_obj": _setup_read(big_obj, 1_000_000),
+    "read_ply": _setup_read(big_ply, 600_000),
     "read_gltf": _setup_read(big_glb, 6_000_000),
     "read_course": _setup_read_course,
     "save_vgrid": _save(2048, ".vgrid", fill=True),

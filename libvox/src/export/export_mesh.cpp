@@ -538,7 +538,10 @@ void writeVoxelMesh(const std::string& path, const VoxelMesh& mesh, bool binary,
       writeOff(out, mesh, check);
       break;
     case MeshFormat::Stl:
-      writeWithOpenMesh(out, ".stl", mesh.isTriangleMesh() ? mesh : triangulateVoxelMesh(mesh), opt, check);
+      writeWithOpenMesh(
+          out, ".stl",
+          mesh.isTriangleMesh() ? mesh : triangulateVoxelMesh(mesh, [&](double) { return !progress || progress(0); }),
+          opt, check);
       break;
     case MeshFormat::Obj:
       writeObj(out, mesh, mtl ? std::filesystem::path(mtl->path()).filename().string() : std::string(), check);

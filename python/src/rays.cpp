@@ -53,15 +53,20 @@ RayBatch rayBatch(const py::handle& origins, const py::handle& directions, const
   return b;
 }
 
-// Runs body(first, last) over the rays on worker threads, stopping early on Ctrl-C.
+// Runs body(first, last) over the rays on worker threads, stopping early on Ctrl-C. simple_partitioner: blocks of at
+// most kRayGrain rays, each asking when done; the default partitioner gave a thread a whole share of the rays
+// between asks (1.6 s before Ctrl-C acted on 4 million rays).
 template <class Body>
 void forRays(Interrupt& interrupt, size_t count, Body&& body) {
   std::atomic<size_t> done{0};
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, kRayGrain), [&](const tbb::blocked_range<size_t>& r) {
-    if (interrupt.cancelled()) return;
-    body(r.begin(), r.end());
-    interrupt.poll(double(done.fetch_add(r.size()) + r.size()) / double(count));
-  });
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, count, kRayGrain),
+      [&](const tbb::blocked_range<size_t>& r) {
+        if (interrupt.cancelled()) return;
+        body(r.begin(), r.end());
+        interrupt.poll(double(done.fetch_add(r.size()) + r.size()) / double(count));
+      },
+      tbb::simple_partitioner());
   if (interrupt.cancelled()) vox::fail<vox::Error>("tracing cancelled");
 }
 

@@ -70,6 +70,7 @@ void save(PyGrid& self, const py::object& pathObj, const py::object& facesName, 
       vox::ViewerPageOptions options;
       options.color = color;
       options.title = std::filesystem::path(self.source()).filename().string();  // as vox-export: the grid's name
+      options.progress = [&](double f) { return interrupt.poll(f); };
       vox::writeViewerPage(*path, grid, self.scene(), options);
     } else if (voxelFormat) {
       std::vector<vox::Rgb8> colors;
@@ -81,7 +82,7 @@ void save(PyGrid& self, const py::object& pathObj, const py::object& facesName, 
       const vox::VoxelMesh mesh = vox::buildVoxelMesh(grid, self.scene(), faces, color, nullptr,
                                                       [&](double f) { return interrupt.poll(0.6 * f); });
       poll(0.6);
-      vox::writeVoxelMesh(*path, mesh, !ascii);
+      vox::writeVoxelMesh(*path, mesh, !ascii, [&](double f) { return interrupt.poll(0.6 + 0.4 * f); });
     }
   });
   if (voxelFormat == vox::VoxelFormat::Binvox && report.binvoxShiftVoxels > 1e-9) {

@@ -127,6 +127,7 @@ BinvoxLayout binvoxLayout(const Grid& grid) {
 BinvoxLayout writeBinvox(std::ostream& out, const Grid& grid, const std::function<void(double)>& progress) {
   binvoxLayout(grid);  // a cube too large is refused before anything else
   tallyVoxels(grid);   // and keys or runs that break the grid's rules before a row is visited
+  if (progress) progress(0);
   return writeBinvox(out, grid, voxelRows(grid), progress);
 }
 
@@ -143,6 +144,9 @@ BinvoxLayout writeBinvox(std::ostream& out, const Grid& plan, const VoxelRowSour
     ++eventStart[r.i0 + r.count + 1];
   });
   for (size_t x = 1; x < eventStart.size(); ++x) eventStart[x] += eventStart[x - 1];
+  // Each serial pass over the rows takes tenths of a second at 2048^3: the progress callback (which throws to
+  // cancel) is asked between them and after every plane.
+  if (progress) progress(0);
   requireMemory(saturatingSum({saturatingMul(eventStart.back(), sizeof(uint32_t)), (d + 1) * sizeof(uint64_t),
                                planeBits / 8 + planeBits / 64 * 5}),
                 "binvox", "run events and one plane (with its words' marks and list)");
@@ -155,6 +159,7 @@ BinvoxLayout writeBinvox(std::ostream& out, const Grid& plan, const VoxelRowSour
       events[fill[r.i0 + r.count]++] = bit;
     });
   }
+  if (progress) progress(0);
 
   char header[256];
   std::snprintf(header, sizeof header, "#binvox 1\ndim %u %u %u\ntranslate %.17g %.17g %.17g\nscale %.17g\ndata\n",
@@ -171,6 +176,7 @@ BinvoxLayout writeBinvox(std::ostream& out, const Grid& plan, const VoxelRowSour
     for (uint32_t w = 0; w < marked.size(); ++w)
       if (marked[w]) active.push_back(w);
   }
+  if (progress) progress(0);
   uint64_t setBits = 0;
   for (uint64_t x = 0; x < d; ++x) {
     for (uint64_t e = eventStart[x]; e < eventStart[x + 1]; ++e) {
@@ -180,7 +186,7 @@ BinvoxLayout writeBinvox(std::ostream& out, const Grid& plan, const VoxelRowSour
       setBits = word & bit ? setBits + 1 : setBits - 1;
     }
     encodePlane(plane, planeBits, setBits, active, enc);
-    if (progress && x % 64 == 0) progress(double(x) / double(d));
+    if (progress) progress(double(x) / double(d));
   }
   enc.finish();
   return layout;

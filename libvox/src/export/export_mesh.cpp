@@ -66,7 +66,11 @@ class VoxelMeshExporter : public OM::IO::BaseExporter {
     edges_ = corners / 2;  // a closed mesh: every edge has two face corners
   }
 
+  // Asked every 65,536th vertex and face OpenMesh asks for (Ctrl-C while a large mesh is written); may throw.
+  const std::function<void()>* check = nullptr;
+
   OM::Vec3f point(OM::VertexHandle v) const override {
+    if (check && (v.idx() & 0xffff) == 0) (*check)();
     const Vec3& p = mesh_.positions[size_t(v.idx())];
     return OM::Vec3f(float(p.x), float(p.y), float(p.z));
   }
@@ -107,6 +111,7 @@ class VoxelMeshExporter : public OM::IO::BaseExporter {
   OM::Attributes::StatusInfo status(OM::VertexHandle) const override { return {}; }
 
   unsigned int get_vhandles(OM::FaceHandle f, std::vector<OM::VertexHandle>& vh) const override {
+    if (check && (f.idx() & 0xffff) == 0) (*check)();
     vh.clear();
     for (uint32_t k = mesh_.faceStart[size_t(f.idx())]; k < mesh_.faceStart[size_t(f.idx()) + 1]; ++k)
       vh.emplace_back(int(mesh_.faceVertices[k]));
@@ -218,8 +223,9 @@ class QuietOpenMesh {
 
 // Through a stream rather than a file name: OpenMesh's writers do not check their writes, the stream does.
 void writeWithOpenMesh(OutputFile& out, const std::string& ext, const VoxelMesh& mesh, OM::IO::Options opt,
-                       std::vector<Rgb8> vertexColors = {}) {
+                       const std::function<void()>& check, std::vector<Rgb8> vertexColors = {}) {
   VoxelMeshExporter exporter(mesh, std::move(vertexColors));
+  exporter.check = &check;
   QuietOpenMesh quiet;
   if (!OM::IO::IOManager().write(out.stream(), ext, exporter, opt, 9)) {
     out.flush();  // a write error is the better message
@@ -231,7 +237,8 @@ void writeWithOpenMesh(OutputFile& out, const std::string& ext, const VoxelMesh&
 // short pieces).
 class BufferedFile {
  public:
-  explicit BufferedFile(OutputFile& out) : out_(out) {}
+  // `check`, asked at every flush (a megabyte), may throw to cancel the write.
+  BufferedFile(OutputFile& out, const std::function<void()>& check) : out_(out), check_(check) {}
   void put(std::string_view s) {
     buffer_.append(s);
     if (buffer_.size() > (1 << 20)) flush();
@@ -247,12 +254,14 @@ class BufferedFile {
     buffer_.append(tmp, r.ptr);
   }
   void flush() {
+    check_();
     out_.write(buffer_);
     buffer_.clear();
   }
 
  private:
   OutputFile& out_;
+  const std::function<void()>& check_;
   std::string buffer_;
 };
 
@@ -301,8 +310,8 @@ std::string mtlText(const VoxelMesh& mesh) {
 }
 
 // Shared vertices; with colours, faces grouped by colour under "usemtl" and `mtlName` (empty: none) as mtllib.
-void writeObj(OutputFile& file, const VoxelMesh& mesh, const std::string& mtlName) {
-  BufferedFile out(file);
+void writeObj(OutputFile& file, const VoxelMesh& mesh, const std::string& mtlName, const std::function<void()>& check) {
+  BufferedFile out(file, check);
   out.put("# voxel mesh written by libvox ");
   out.put(versionString());
   out.put("\n");
@@ -336,8 +345,8 @@ void writeObj(OutputFile& file, const VoxelMesh& mesh, const std::string& mtlNam
 
 // Geomview OFF: "OFF", counts, vertices, then faces as "n v0 .. vn-1" followed by the face's colour as three
 // integers 0..255 (the form MeshLab reads; a "COFF" header would promise per-vertex colours instead).
-void writeOff(OutputFile& file, const VoxelMesh& mesh) {
-  BufferedFile out(file);
+void writeOff(OutputFile& file, const VoxelMesh& mesh, const std::function<void()>& check) {
+  BufferedFile out(file, check);
   out.put("OFF\n");  // no comment line: not every reader skips one
   out.number(uint64_t(mesh.vertexCount()));
   out.put(" ");
@@ -497,8 +506,12 @@ void writeGltf(OutputFile& out, const VoxelMesh& polygons, bool binary) {
 
 }  // namespace
 
-void writeVoxelMesh(const std::string& path, const VoxelMesh& mesh, bool binary) {
+void writeVoxelMesh(const std::string& path, const VoxelMesh& mesh, bool binary,
+                    const std::function<bool(double)>& progress) {
   const MeshFormat format = meshFormatFromPath(path);
+  const std::function<void()> check = [&] {
+    if (progress && !progress(0)) fail<Error>(path, ": writing cancelled");
+  };
   // An OBJ's colours go to a .mtl beside it, written first so that the OBJ never names a missing file. A device
   // (e.g. /dev/stdout) gets no .mtl: there is no folder beside it.
   std::unique_ptr<OutputFile> mtl;
@@ -519,16 +532,19 @@ void writeVoxelMesh(const std::string& path, const VoxelMesh& mesh, bool binary)
   }
   switch (format) {
     case MeshFormat::Ply:
-      writeWithOpenMesh(out, ".ply", mesh, opt, dominantVertexColors(mesh));
+      writeWithOpenMesh(out, ".ply", mesh, opt, check, dominantVertexColors(mesh));
       break;
     case MeshFormat::Off:
-      writeOff(out, mesh);
+      writeOff(out, mesh, check);
       break;
     case MeshFormat::Stl:
-      writeWithOpenMesh(out, ".stl", mesh.isTriangleMesh() ? mesh : triangulateVoxelMesh(mesh), opt);
+      writeWithOpenMesh(
+          out, ".stl",
+          mesh.isTriangleMesh() ? mesh : triangulateVoxelMesh(mesh, [&](double) { return !progress || progress(0); }),
+          opt, check);
       break;
     case MeshFormat::Obj:
-      writeObj(out, mesh, mtl ? std::filesystem::path(mtl->path()).filename().string() : std::string());
+      writeObj(out, mesh, mtl ? std::filesystem::path(mtl->path()).filename().string() : std::string(), check);
       if (mtl) mtl->commit();
       break;
     case MeshFormat::Glb:

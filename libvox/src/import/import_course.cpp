@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "import/import_progress.h"
 #include "import/obj_reader.h"
 #include "vox/core/error.h"
 #include "vox/import/import.h"
@@ -27,12 +28,12 @@ struct Token {
 
 bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v'; }
 
-std::vector<Token> tokenize(std::string_view text) {
+std::vector<Token> tokenize(std::string_view text, ImportProgress& progress) {
   std::vector<Token> tokens;
   int line = 1;
   size_t i = 0;
   while (i < text.size()) {
-    if (text[i] == '\n') ++line;
+    if (text[i] == '\n') progress.step(uint64_t(++line), 0.1 + 0.2 * double(i) / double(text.size()));
     if (isSpace(text[i])) {
       ++i;
       continue;
@@ -89,9 +90,10 @@ std::optional<double> similarityScale(const Mat4& t) {
 
 class CourseParser {
  public:
-  explicit CourseParser(std::string path) : path_(std::move(path)) {
+  CourseParser(std::string path, const std::function<bool(double)>& progress)
+      : path_(std::move(path)), progress_(progress, path_) {
     text_ = readInputFile(path_, "scene file");
-    tokens_ = tokenize(text_);
+    tokens_ = tokenize(text_, progress_);
     folder_ = std::filesystem::path(path_).parent_path();
   }
 
@@ -435,6 +437,7 @@ class CourseParser {
   }
 
   void parseObject(const Token& t, const Mat4& m, Primitives& out) {
+    progress_.step(++objects_, 0.3 + 0.6 * double(pos_) / double(std::max<size_t>(tokens_.size(), 1)));
     // Objects nest through recursion; an absurd depth in an untrusted file must not overflow the stack.
     constexpr int kMaxNesting = 256;
     if (nesting_ >= kMaxNesting) failAt(t, "objects nested deeper than ", kMaxNesting);
@@ -578,6 +581,9 @@ class CourseParser {
   }
 
   std::string path_;
+  // Asked every 4096th line and object: a scene of 600,000 triangles takes seconds to read.
+  ImportProgress progress_;
+  uint64_t objects_ = 0;
   std::string text_;
   std::vector<Token> tokens_;  // views into text_
   size_t pos_ = 0;
@@ -591,6 +597,8 @@ class CourseParser {
 
 }  // namespace
 
-Scene importCourseScene(const std::string& path) { return CourseParser(path).parse(); }
+Scene importCourseScene(const std::string& path, const std::function<bool(double)>& progress) {
+  return CourseParser(path, progress).parse();
+}
 
 }  // namespace vox

@@ -28,6 +28,7 @@
 #include <string_view>
 #include <vector>
 
+#include "import/import_progress.h"
 #include "vox/io/texture_decode.h"
 #include "vox/core/error.h"
 #include "vox/import/import.h"
@@ -103,7 +104,8 @@ std::vector<int> parentlessNodes(const tinygltf::Model& model) {
 
 class GltfReader {
  public:
-  GltfReader(std::string path, const tinygltf::Model& model) : path_(std::move(path)), model_(model) {}
+  GltfReader(std::string path, const tinygltf::Model& model, ImportProgress& progress)
+      : path_(std::move(path)), model_(model), progress_(progress) {}
 
   Scene read() {
     readMaterials();
@@ -436,6 +438,7 @@ class GltfReader {
     const View view = accessorView(accessorIndex, 12);
     std::vector<Vec3> out(view.count);
     for (size_t i = 0; i < view.count; ++i) {
+      progress_.step(i, 0.5);
       float xyz[3];
       std::memcpy(xyz, view.base + i * view.stride, sizeof xyz);
       out[i] = {xyz[0], xyz[1], xyz[2]};
@@ -454,6 +457,7 @@ class GltfReader {
     const View view = accessorView(accessorIndex, size);
     std::vector<uint32_t> out(view.count);
     for (size_t i = 0; i < view.count; ++i) {
+      progress_.step(i, 0.5);
       const unsigned char* p = view.base + i * view.stride;
       uint32_t value = 0;
       if (size == 1) {
@@ -526,6 +530,7 @@ class GltfReader {
       }
 
       auto emit = [&](uint32_t a, uint32_t b, uint32_t c) {
+        progress_.step(scene_.triangles.size(), 0.6);
         scene_.triangles.push_back({{vertices[a], vertices[b], vertices[c]}, material});
         if (!uv.empty()) {
           scene_.triangleUVs.resize(scene_.triangles.size() - 1);  // zeros for the untextured triangles before
@@ -554,6 +559,7 @@ class GltfReader {
 
   std::string path_;
   const tinygltf::Model& model_;
+  ImportProgress& progress_;  // asked every 4096th vertex, index and triangle: 6 million triangles take seconds
   Scene scene_;
   uint32_t defaultMaterial_ = 0;
   bool usesDefaultMaterial_ = false;
@@ -753,8 +759,11 @@ std::vector<std::string> nonEmptyLines(const std::string& text) {
 
 }  // namespace
 
-Scene importGltf(const std::string& path) {
+Scene importGltf(const std::string& path, const std::function<bool(double)>& progress) {
+  ImportProgress report(progress, path);
   const std::string bytes = readInputFile(path, "glTF file");
+  report.report(0.1);
+  report.check();
   // tinygltf takes the size as an unsigned int: a larger file would be cut silently.
   if (bytes.size() > std::numeric_limits<unsigned>::max())
     fail<InputError>(path, ": ", bytes.size(), " bytes; tinygltf reads glTF files of at most 4 GiB");
@@ -786,8 +795,10 @@ Scene importGltf(const std::string& path) {
     return m.pbrMetallicRoughness.baseColorTexture.index >= 0;
   });
   checkInstancedTriangles(path, model, textured);
+  report.report(0.4);  // tinygltf parsed the file in one call, copying its buffers
+  report.check();
 
-  Scene scene = GltfReader(path, model).read();
+  Scene scene = GltfReader(path, model, report).read();
   for (const std::string& line : nonEmptyLines(warn)) scene.warnings.push_back(path + ": " + quoteInput(line, 300));
   return scene;
 }

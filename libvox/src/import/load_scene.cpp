@@ -17,11 +17,11 @@ Scene loadScene(const std::string& path, const std::function<bool(double)>& prog
   requireRegularFile(path, "scene file");
   Scene scene;
   if (ext == ".txt")
-    scene = importCourseScene(path);
+    scene = importCourseScene(path, progress);
   else if (ext == ".obj")
     scene = importObj(path, progress);
   else if (ext == ".gltf" || ext == ".glb")
-    scene = importGltf(path);
+    scene = importGltf(path, progress);
   else if (ext == ".ply")
     scene = importPly(path, progress);
   else

@@ -412,6 +412,17 @@ struct WindowContext {
   const bool packed;                            // references as key << primBits | id (else pairs)
   std::array<std::vector<double>, 3> boundary;  // cellBoundary(grid.bounds, dims, a, i) for i in [0, dims[a]]
   std::array<double, 3> boundaryScale;          // cells per unit: a first guess of a cell index
+  // Primitives done of `nWork`, for checkCancel's fraction (voxelizeWindow counts them).
+  mutable std::atomic<size_t> done{0};
+  size_t nWork = 1;
+
+  // Asked every kCancelCells cells of one primitive's cell loop: a ball or a bbox at 1000^3 is one primitive of up
+  // to 10^9 cells, seconds between the block reports. Throws once the progress callback says stop.
+  static constexpr uint32_t kCancelCells = 1 << 16;
+  void checkCancel() const {
+    if (options.progress && !options.progress(0.9 * double(done.load(std::memory_order_relaxed)) / double(nWork)))
+      fail<Error>("voxelization cancelled");
+  }
 
   Box cellBox(int64_t i, int64_t j, int64_t k) const {
     return Box{{boundary[0][i], boundary[1][j], boundary[2][k]},
@@ -428,10 +439,17 @@ struct WindowContext {
 
 // Calls f(i, j, k) for every cell of `range`, x fastest.
 template <typename F>
-void forEachCell(const CellRange& range, F&& f) {
+void forEachCell(const WindowContext& ctx, const CellRange& range, F&& f) {
+  uint32_t n = 0;
   for (int64_t k = range.first[2]; k <= range.last[2]; ++k)
     for (int64_t j = range.first[1]; j <= range.last[1]; ++j)
-      for (int64_t i = range.first[0]; i <= range.last[0]; ++i) f(i, j, k);
+      for (int64_t i = range.first[0]; i <= range.last[0]; ++i) {
+        if (++n == WindowContext::kCancelCells) {
+          n = 0;
+          ctx.checkCancel();
+        }
+        f(i, j, k);
+      }
 }
 
 // OverlapMethod::Center, the course's quick test: the cell's centre inside the footprint (the triangle's bounding
@@ -440,7 +458,7 @@ void centerCells(const WindowContext& ctx, size_t id, const Box& primBox, const 
   const bool isTri = id < ctx.nTri;
   Mat4 toObject;
   if (!isTri) toObject = inverse(ctx.scene.spheres[id - ctx.nTri].transform);
-  forEachCell(range, [&](int64_t i, int64_t j, int64_t k) {
+  forEachCell(ctx, range, [&](int64_t i, int64_t j, int64_t k) {
     const Box b = ctx.cellBox(i, j, k);
     const Vec3 c = (b.lo + b.hi) * 0.5;
     bool take;
@@ -459,7 +477,7 @@ void centerCells(const WindowContext& ctx, size_t id, const Box& primBox, const 
 // A sphere's cells by the separating axes (sat) or the filtered exact test.
 void sphereCells(const WindowContext& ctx, size_t id, const CellRange& range, Local& local) {
   const Sphere& s = ctx.scene.spheres[id - ctx.nTri];
-  forEachCell(range, [&](int64_t i, int64_t j, int64_t k) {
+  forEachCell(ctx, range, [&](int64_t i, int64_t j, int64_t k) {
     bool fallback = false;
     const bool hit = ctx.options.method == OverlapMethod::Sat ? sphereBoxSat(s, ctx.cellBox(i, j, k))
                                                               : sphereBoxFiltered(s, ctx.cellBox(i, j, k), &fallback);
@@ -544,7 +562,7 @@ void voxelizePrimitive(const WindowContext& ctx, size_t id, Local& local) {
   if (!range) return;
   switch (ctx.options.method) {
     case OverlapMethod::BBox:
-      forEachCell(*range, [&](int64_t i, int64_t j, int64_t k) { ctx.emit(local, id, i, j, k); });
+      forEachCell(ctx, *range, [&](int64_t i, int64_t j, int64_t k) { ctx.emit(local, id, i, j, k); });
       local.tested += range->count();
       return;
     case OverlapMethod::Center:
@@ -583,7 +601,8 @@ void voxelizeWindow(const Scene& scene, Grid& grid, const CellWindow& window, co
   const auto start = std::chrono::steady_clock::now();
   const size_t nWork = ids.size();
   const double estimate = checkReferenceBudget(scene, grid, window, ids, options);
-  const WindowContext ctx(scene, grid, window, options);
+  WindowContext ctx(scene, grid, window, options);
+  ctx.nWork = std::max<size_t>(nWork, 1);
 
   // Each thread's references reserved once, on huge pages, so that they are never copied to grow: its share of the
   // (generous) estimate, twice over when threads are few, since the primitives are not spread evenly. Address space
@@ -595,7 +614,7 @@ void voxelizeWindow(const Scene& scene, Grid& grid, const CellWindow& window, co
     if (ctx.packed) l.packedRefs.reserve(perThread);
     return l;
   });
-  std::atomic<size_t> done{0};
+  std::atomic<size_t>& done = ctx.done;
   std::atomic<bool> cancelled{false};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nWork, 256), [&](const tbb::blocked_range<size_t>& r) {
     if (cancelled.load(std::memory_order_relaxed)) return;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <string_view>
 
@@ -22,6 +23,9 @@ struct ViewerPageOptions {
   ColorMode color = ColorMode::Count;  // as vox-export --color: the surface, the cut faces and the cell colours
   uint32_t idsPerCell = 4;             // the first primitive ids of each cell kept for the page's cell info
   std::string title;                   // shown by the page (the grid's file name); UTF-8
+  // Asked every few milliseconds with the fraction done (from the calling thread, and from worker threads while the
+  // surface is built); returning false cancels the write with Error("viewer page cancelled"), the old file kept.
+  std::function<bool(double)> progress;
 };
 
 // What encodeViewerData wrote, for --stats and tests.

@@ -125,7 +125,10 @@ MeshFormat meshFormatFromPath(const std::string& path);
 //  - .stl (OpenMesh; binary unless binary is false): triangles, no colour.
 //  - .glb, .gltf (tinygltf; buffers embedded): one POSITION accessor shared by one triangle primitive per colour,
 //    each with a matte material whose baseColorFactor is the colour made linear; viewers compute flat normals.
-// Throws InputError for an unknown extension, OutputError when the file cannot be written.
-void writeVoxelMesh(const std::string& path, const VoxelMesh& mesh, bool binary = true);
+// Throws InputError for an unknown extension, OutputError when the file cannot be written. `progress` (may be
+// empty) is asked every megabyte of text and every 65,536th vertex and face of PLY and STL; returning false cancels
+// with Error("PATH: writing cancelled"), no file left.
+void writeVoxelMesh(const std::string& path, const VoxelMesh& mesh, bool binary = true,
+                    const std::function<bool(double)>& progress = {});
 
 }  // namespace vox

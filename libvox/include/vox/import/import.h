@@ -12,14 +12,15 @@ namespace vox {
 // Dispatches on the extension: .txt (course format), .obj, .gltf/.glb, .ply. `progress` (may be empty) is called
 // with the fraction read while the OBJ and PLY importers parse, from worker threads and from the calling thread, the
 // latter every few milliseconds of parsing; return false to cancel (throws vox::Error "PATH: reading cancelled").
-// The glTF and course formats are read without it (tinygltf parses in one call; course scenes are small).
+// glTF asks it after tinygltf's parse (one call) and every 4096th vertex, index and triangle; the course format
+// every 4096th line and object.
 Scene loadScene(const std::string& path, const std::function<bool(double)>& progress = {});
 
 // The MIT 6.837 text scene format (grammar in seed-scenes/6837/README.md). TriangleMesh paths are resolved relative
 // to the scene file's folder. Procedural materials (Checkerboard, Noise, Marble, Wood) become their first
 // material's colour, with a warning. Cameras get CameraSpan::LongerSide: the angle or size spans the image's longer
-// side, as in the course's code.
-Scene importCourseScene(const std::string& path);
+// side, as in the course's code. `progress` as loadScene's.
+Scene importCourseScene(const std::string& path, const std::function<bool(double)>& progress = {});
 // Wavefront OBJ, read by libvox's own reader in double precision (a coordinate comes back bit for bit from 17
 // significant digits): polygons of any size fan-triangulated, negative indices, line continuations. .mtl: Kd ->
 // diffuse, Ks -> specular, Ns -> exponent, Ni -> indexOfRefraction; faces without a material get a default white
@@ -36,8 +37,9 @@ Scene importObj(const std::string& path, const std::function<bool(double)>& prog
 // colour textures are not sampled (one warning). Lights: directional along the node's -Z, point at the node's
 // origin, spot -> point (warning). glTF intensities are physical (lux, candela) and a Phong shader has no exposure
 // to map them, so Light::color = color * min(intensity, 1) and point lights get no distance falloff (attenuation
-// 1 0 0). Accessor, bufferView and index ranges are checked: InputError "file: accessor N: ...".
-Scene importGltf(const std::string& path);
+// 1 0 0). Accessor, bufferView and index ranges are checked: InputError "file: accessor N: ...". `progress` as
+// loadScene's.
+Scene importGltf(const std::string& path, const std::function<bool(double)>& progress = {});
 // PLY triangle meshes (ASCII and binary), read by libvox itself: coordinates exact (double properties bit for bit),
 // faces fan-triangulated. Throws InputError naming the file and the line (ASCII) or element and byte (binary) on a
 // value that does not fit its declared type, a vertex index out of range, or an element count the file cannot hold.

@@ -346,9 +346,6 @@ def run(case, moments, bunny):
         start = time.monotonic()
         call()
         length = time.monotonic() - start
-        # Before issue 45 the library's own SIGINT handler, installed by the first write, stayed installed and ended
-        # the process (status 130); Python's is put back so that a save's interrupt is measured either way.
-        signal.signal(signal.SIGINT, signal.default_int_handler)
         before = sorted(os.listdir(folder))
         old = out.read_bytes() if out else None
         results = []

@@ -128,20 +128,6 @@ Scene vfTransformed(Scene s, const Mat4& m) {
   return s;
 }
 
-// A tetrahedron of outward triangles.
-Scene vfTetrahedron(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
-  Scene s;
-  s.materials.push_back({});
-  const Vec3 p[4] = {a, b, c, d};
-  const int faces[4][4] = {{0, 1, 2, 3}, {0, 3, 1, 2}, {1, 3, 2, 0}, {0, 2, 3, 1}};
-  for (const auto& f : faces) {
-    Triangle t{{p[f[0]], p[f[1]], p[f[2]]}};
-    if (dot(cross(t.v[1] - t.v[0], t.v[2] - t.v[0]), p[f[3]] - t.v[0]) > 0) std::swap(t.v[1], t.v[2]);
-    s.triangles.push_back(t);
-  }
-  return s;
-}
-
 // An octahedron of outward triangles: centre c, half-diagonal r along the axes.
 Scene vfOctahedron(const Vec3& c, double r) {
   Scene s;
@@ -183,7 +169,8 @@ void vfExpectMatchesExact(const Scene& poly, const Grid& g, const std::string& w
 TEST(VolumeFractions, ConvexPolyhedraMatchExactClip) {
   vfExpectMatchesExact(testing::boxScene(0.1, 0.9),
                        vfVoxelize(testing::boxScene(0.1, 0.9), {4, 4, 4}, Box{{0, 0, 0}, {1, 1, 1}}), "cube");
-  const Scene tet = vfTetrahedron({0.05, 0.1, 0.02}, {0.93, 0.2, 0.11}, {0.3, 0.88, 0.25}, {0.41, 0.37, 0.97});
+  const Scene tet =
+      testing::tetrahedronScene({0.05, 0.1, 0.02}, {0.93, 0.2, 0.11}, {0.3, 0.88, 0.25}, {0.41, 0.37, 0.97});
   vfExpectMatchesExact(tet, vfVoxelize(tet, {5, 4, 6}), "tetrahedron");
   const Mat4 rotated = translation({0.5, 0.5, 0.5}) * rotation({1, 2, 3}, 37);
   const Scene rot = vfConvexHull(vfVertices(vfTransformed(testing::boxScene(-0.3, 0.3), rotated)));

@@ -7,16 +7,7 @@ import numpy as np
 import pytest
 
 import libvox
-from conftest import assert_same_grid
-
-
-def box(lo, hi, inward=False):
-    """The 12 outward (or inward) triangles of the box [lo, hi] as (vertices, faces)."""
-    v = np.array([[hi[0] if c & 1 else lo[0], hi[1] if c & 2 else lo[1], hi[2] if c & 4 else lo[2]]
-                  for c in range(8)], dtype=np.float64)
-    f = np.array([[0, 2, 3], [0, 3, 1], [4, 5, 7], [4, 7, 6], [0, 1, 5], [0, 5, 4],
-                  [2, 6, 7], [2, 7, 3], [0, 4, 6], [0, 6, 2], [1, 3, 7], [1, 7, 5]], dtype=np.int64)
-    return v, (f[:, ::-1] if inward else f)
+from conftest import assert_same_grid, box
 
 
 def hollow_box():

@@ -27,6 +27,7 @@ from hypothesis import HealthCheck, example, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
 import libvox  # noqa: E402
+from conftest import box  # noqa: E402
 
 EXAMPLES = int(os.environ.get("VOX_HYPOTHESIS_EXAMPLES", "25"))
 PROPERTY = settings(max_examples=EXAMPLES, derandomize=True, deadline=None, database=None,
@@ -36,18 +37,6 @@ METHODS = ["exact", "sat", "bbox", "center"]
 pytestmark = pytest.mark.filterwarnings("ignore:.*nothing filled")
 
 # ---- Meshes ----
-
-_BOX_FACES = np.array([[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4],
-                       [2, 3, 7], [2, 7, 6], [1, 2, 6], [1, 6, 5], [0, 4, 7], [0, 7, 3]], dtype=np.int64)
-
-
-def box(lo, hi):
-    """An axis-aligned box, 12 triangles wound outward."""
-    (x0, y0, z0), (x1, y1, z1) = lo, hi
-    v = np.array([[x0, y0, z0], [x1, y0, z0], [x1, y1, z0], [x0, y1, z0],
-                  [x0, y0, z1], [x1, y0, z1], [x1, y1, z1], [x0, y1, z1]], dtype=np.float64)
-    return v, _BOX_FACES.copy()
-
 
 def concat(*meshes):
     vs, fs, n = [], [], 0
@@ -94,8 +83,8 @@ def meshes(draw):
         return kind, v, f, None
     if kind == "inside_out":
         lo, hi = draw(boxes())
-        v, f = box(lo, hi)
-        return kind, v, f[:, ::-1].copy(), None
+        v, f = box(lo, hi, inward=True)
+        return kind, v, f.copy(), None
     if kind == "two_boxes":  # overlapping: self-intersecting, winding number 2 where they overlap
         return (kind, *concat(box(*draw(boxes())), box(*draw(boxes()))), None)
     if kind == "open":

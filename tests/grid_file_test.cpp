@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <random>
 
@@ -13,6 +14,7 @@
 #include "vox/core/error.h"
 #include "vox/trace/render.h"
 #include "vox/export/voxel_mesh.h"
+#include "vox/io/atomic_file.h"
 #include "vox/io/grid_file.h"
 #include "vox/voxelize/voxelize.h"
 
@@ -77,6 +79,33 @@ TEST(GridFile, RoundTripsEverything) {
   EXPECT_EQ(back.grid.outsidePrims, grid.outsidePrims);
   // Same bytes again: encoding is deterministic.
   EXPECT_EQ(encodeGridFile(back.scene, back.grid), encodeGridFile(scene, grid));
+}
+
+// A write cancelled at any of its progress calls (Ctrl-C in Python's save) throws, leaves the old output byte for
+// byte and no temporary file; progress runs from 0 to 1.
+TEST(GridFile, CancelledWriteKeepsTheOldOutput) {
+  const Scene scene = testing::boxScene(0, 1);
+  VoxelizeOptions opt;
+  opt.dims = {64, 64, 64};
+  const Grid grid = voxelizeScene(scene, opt);
+  testing::ScratchDir dir("gridfile_cancel");
+  const std::string path = dir.file("a.vgrid");
+  writeFileAtomically(path, "old bytes");
+  int calls = 0;
+  double last = 0;
+  writeGridFile(dir.file("full.vgrid"), scene, grid, nullptr, [&](double f) {
+    EXPECT_GE(f, last);
+    last = f;
+    return ++calls > 0;
+  });
+  EXPECT_EQ(last, 1.0);
+  ASSERT_GT(calls, 3);
+  for (int stop : {1, 2, calls / 2, calls}) {
+    int seen = 0;
+    EXPECT_THROW(writeGridFile(path, scene, grid, nullptr, [&](double) { return ++seen < stop; }), Error) << stop;
+    EXPECT_EQ(testing::readAll(path), "old bytes") << stop;
+  }
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 2);  // a.vgrid, full.vgrid
 }
 
 TEST(GridFile, EveryTruncationAndBitFlipIsRefused) {

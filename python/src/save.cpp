@@ -65,7 +65,7 @@ void save(PyGrid& self, const py::object& pathObj, const py::object& facesName, 
       // brick by brick instead, to keep one brick in memory; here the whole grid is in memory already).
       vox::writeGridAsSet(*path, self.scene(), grid, *bricks, [&](double f) { return interrupt.poll(f); });
     } else if (gridFile) {
-      vox::writeGridFile(*path, self.scene(), grid);
+      vox::writeGridFile(*path, self.scene(), grid, nullptr, [&](double f) { return interrupt.poll(f); });
     } else if (page) {
       vox::ViewerPageOptions options;
       options.color = color;

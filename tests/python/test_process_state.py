@@ -28,6 +28,8 @@ PRELUDE = textwrap.dedent("""
     def save(grid, name):
         path, _, bricks = name.partition(":")
         try:
+            if bricks and grid.sdf_half_width > 0:  # a grid set holds no distances: the band's grid refuses it
+                grid = libvox.voxelize((V, F), resolution=8, fill=True)
             grid.save(os.path.join(folder, path), **({"bricks": 2} if bricks else {}))
             return True
         except libvox.UsageError as e:

@@ -3,6 +3,8 @@
 // file is written, synced and read in a quarter of the bytes.
 #pragma once
 
+#include <functional>
+
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -19,7 +21,9 @@ struct EncodedCellTable {
   uint64_t occupied = 0, references = 0;
   HugeVector<char> bytes;  // on huge pages: see encodeCellTable
 };
-EncodedCellTable encodeCellTable(const Grid& grid);
+// `progress`, when given, is asked (from worker threads) with a fraction in [0, 1] once per chunk of 2^15 cells;
+// returning false cancels: vox::Error "grid file: encoding cancelled".
+EncodedCellTable encodeCellTable(const Grid& grid, const std::function<bool(double)>& progress = {});
 
 // Writes the table: u64 occupied, u64 references, u64 bytes, then the bytes.
 void putCellTable(ByteWriter& w, const EncodedCellTable& table);

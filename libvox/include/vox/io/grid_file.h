@@ -2,6 +2,7 @@
 // Layout in docs/grid-format.md.
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "vox/core/grid.h"
@@ -31,7 +32,10 @@ struct WriteTimes {
   double writeSeconds = 0;
   double syncSeconds = 0;
 };
-void writeGridFile(const std::string& path, const Scene& scene, const Grid& grid, WriteTimes* times = nullptr);
+// `progress`, when given, is called with a fraction in [0, 1] at least every 64 KiB written (and between the passes);
+// returning false cancels: vox::Error "PATH: write cancelled", the old output untouched (Ctrl-C in Python's save).
+void writeGridFile(const std::string& path, const Scene& scene, const Grid& grid, WriteTimes* times = nullptr,
+                   const std::function<bool(double)>& progress = {});
 
 // Reads and checks every count, offset, id and the checksum. Throws InputError naming the path and the byte offset
 // for a truncated, corrupt or newer-version file.

@@ -106,6 +106,12 @@ TEST(GridFile, CancelledWriteKeepsTheOldOutput) {
     EXPECT_EQ(testing::readAll(path), "old bytes") << stop;
   }
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 2);  // a.vgrid, full.vgrid
+  // Reading and encoding (load, pickling) cancel the same way.
+  EXPECT_THROW(readGridFile(dir.file("full.vgrid"), [](double) { return false; }), Error);
+  EXPECT_THROW(encodeGridFile(scene, grid, 0, [](double) { return false; }), Error);
+  int reads = 0;
+  EXPECT_EQ(readGridFile(dir.file("full.vgrid"), [&](double) { return ++reads > 0; }).grid.cellKeys, grid.cellKeys);
+  EXPECT_GT(reads, 0);
 }
 
 TEST(GridFile, EveryTruncationAndBitFlipIsRefused) {

@@ -182,12 +182,11 @@ py::str sourceText(const PyGrid& self) {
 }
 
 py::object getState(const PyGrid& self) {
-  std::string bytes;
-  {
-    py::gil_scoped_release release;
+  Interrupt interrupt;  // Ctrl-C while a large grid is encoded
+  const std::string bytes = runLong(interrupt, std::nullopt, [&] {
     vox::checkGridBeforeWrite(self.grid(), self.source());  // no pickle that unpickling refuses
-    bytes = vox::encodeGridFile(self.scene(), self.grid());
-  }
+    return vox::encodeGridFile(self.scene(), self.grid(), 0, [&](double f) { return interrupt.poll(f); });
+  });
   return py::make_tuple(py::bytes(bytes), sourceText(self));
 }
 
@@ -204,11 +203,10 @@ std::shared_ptr<PyGrid> fromState(const py::handle& state) {
   const std::string bytes = items[0].cast<std::string>();
   const py::object sourceObj = items[1];
   const std::string source = sourceObj.equal(py::str("<arrays>")) ? "<arrays>" : pathArg(sourceObj, "source");
-  vox::GridFile file;
-  {
-    py::gil_scoped_release release;
-    file = vox::decodeGridFile(bytes, "pickled grid (" + source + ")");
-  }
+  Interrupt interrupt;
+  vox::GridFile file = runLong(interrupt, std::nullopt, [&] {
+    return vox::decodeGridFile(bytes, "pickled grid (" + source + ")", [&](double f) { return interrupt.poll(f); });
+  });
   return std::make_shared<PyGrid>(std::move(file), source);
 }
 
@@ -368,7 +366,9 @@ on a boundary between cells counts for both; points outside the bounds are False
       [](const py::object& path) {
         const std::string p = pathArg(path, "path");
         Interrupt interrupt;
-        vox::GridFile file = runLong(interrupt, std::nullopt, [&] { return vox::readGridOrSet(p); });
+        vox::GridFile file = runLong(interrupt, std::nullopt, [&] {
+          return vox::readGridOrSet(p, [&](double f) { return interrupt.poll(f); });
+        });
         return std::make_shared<PyGrid>(std::move(file), p);
       },
       py::arg("path"), R"doc(

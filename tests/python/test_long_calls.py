@@ -25,10 +25,8 @@ from long_calls import CASES
 # length). The 0.5 s promise is measured by bench/python_ctrl_c.py (docs/python.md).
 LATENCY_LIMIT = 2.0
 
-# Calls without cancellation yet: the grid file's decoder and encoder ask nothing. (pickle.dumps runs the encoder
-# too, but its unchecked part, about 1 s for the bunny at 2048^3, is inside the test's limit.)
+# Calls without cancellation yet.
 NOT_YET = {
-    "load": "readGridOrSet and decodeGridFile take no progress callback",
     "save_gltf": "tinygltf builds the .gltf (its buffer base64-encoded) in one call: 2.7 s past Ctrl-C",
 }
 

@@ -123,7 +123,7 @@ class TableDecoder {
 
 }  // namespace
 
-void getCellTable(ByteReader& r, Grid& grid, uint64_t bounded) {
+void getCellTable(ByteReader& r, Grid& grid, uint64_t bounded, const std::function<bool(double)>& progress) {
   const size_t at = r.position();
   const uint64_t occupied = r.get<uint64_t>(), references = r.get<uint64_t>(), size = r.get<uint64_t>();
   const size_t bodyAt = r.position();
@@ -143,6 +143,8 @@ void getCellTable(ByteReader& r, Grid& grid, uint64_t bounded) {
   uint64_t key = 0, ref = 0;
   int64_t previousFirst = 0;
   for (uint64_t c = 0; c < occupied; ++c) {
+    if (progress && (c & 0xffff) == 0 && !progress(double(c) / double(occupied)))
+      fail<Error>(r.name(), ": reading cancelled");
     const uint64_t gap = d.varint();
     const uint64_t next = c == 0 ? 0 : key + 1;  // key + 1 <= cells: key < cells
     if (next >= cells || gap >= cells - next) d.bad("cell key outside the grid");

@@ -31,6 +31,7 @@ void putCellTable(ByteWriter& w, const EncodedCellTable& table);
 // Reads a table into grid.cellKeys, cellStart and primIds, checking as it decodes that keys ascend inside the grid
 // (whose dims are read), ids ascend within a cell below `bounded`, and counts and bytes match exactly: the same
 // guarantees as version 2's checks. Memory is bounded by the file: a cell takes at least 3 bytes, an id 1.
-void getCellTable(ByteReader& r, Grid& grid, uint64_t bounded);
+// `progress` asked every 2^16 cells; false cancels (vox::Error "NAME: reading cancelled").
+void getCellTable(ByteReader& r, Grid& grid, uint64_t bounded, const std::function<bool(double)>& progress = {});
 
 }  // namespace vox

@@ -249,12 +249,13 @@ void streamPayload(const Scene& scene, const Grid& grid, const EncodedCellTable&
 
 uint32_t gridFileVersionFor(const Grid& grid) { return grid.sdfHalfWidth > 0 || !grid.fractions.empty() ? 4 : 3; }
 
-std::string encodeGridFile(const Scene& scene, const Grid& grid, uint32_t version) {
+std::string encodeGridFile(const Scene& scene, const Grid& grid, uint32_t version,
+                           const std::function<bool(double)>& progress) {
   if (version == 0) version = gridFileVersionFor(grid);
   if (version < gridFileVersionFor(grid) && version >= 3)
     fail<UsageError>("grid file version ", version, " cannot hold distances or volume fractions");
   if (version < 2 || version > kGridFileVersion) fail<UsageError>("cannot write grid file version ", version);
-  const EncodedCellTable table = version >= 3 ? encodeCellTable(grid) : EncodedCellTable{};
+  const EncodedCellTable table = version >= 3 ? encodeCellTable(grid, progress) : EncodedCellTable{};
   const uint64_t cellBytes = version >= 3 ? table.bytes.size() : grid.cellKeys.size() * 16 + grid.primIds.size() * 4;
   ByteWriter w;
   w.bytes().reserve(kHeaderSize + 256 + scene.triangles.size() * 76 + cellBytes + scene.materials.size() * 128);
@@ -397,7 +398,8 @@ void checkFlatCellTable(const Grid& grid, uint64_t bounded, const std::string& n
 
 }  // namespace
 
-GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
+GridFile decodeGridFile(const std::string& bytes, const std::string& name,
+                        const std::function<bool(double)>& progress) {
   const uint32_t version = checkHeader(bytes, name);
   ByteReader r(bytes, kHeaderSize, name);
   GridFile out;
@@ -410,7 +412,7 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name) {
   const uint64_t bounded = scene.triangles.size() + scene.spheres.size();
   const size_t cellsAt = r.position();
   if (version >= 3) {
-    getCellTable(r, grid, bounded);
+    getCellTable(r, grid, bounded, progress);
   } else {
     grid.cellKeys = r.getArray<uint64_t, HugeVector<uint64_t>>("cell");
     grid.cellStart = r.getArray<uint64_t, HugeVector<uint64_t>>("cell start");
@@ -482,9 +484,9 @@ void writeGridFile(const std::string& path, const Scene& scene, const Grid& grid
   }
 }
 
-GridFile readGridFile(const std::string& path) {
+GridFile readGridFile(const std::string& path, const std::function<bool(double)>& progress) {
   // readInputFile refuses non-regular files and sizes the memory budget cannot hold, before reading them whole.
-  return decodeGridFile(readInputFile(path, "grid file"), path);
+  return decodeGridFile(readInputFile(path, "grid file"), path, progress);
 }
 
 }  // namespace vox

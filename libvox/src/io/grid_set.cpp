@@ -346,6 +346,8 @@ bool isGridSet(const std::string& path) {
   return in.gcount() == 8 && std::memcmp(magic, kSetMagic, 8) == 0;
 }
 
-GridFile readGridOrSet(const std::string& path) { return isGridSet(path) ? readGridSet(path) : readGridFile(path); }
+GridFile readGridOrSet(const std::string& path, const std::function<bool(double)>& progress) {
+  return isGridSet(path) ? readGridSet(path) : readGridFile(path, progress);
+}
 
 }  // namespace vox

@@ -38,8 +38,9 @@ void writeGridFile(const std::string& path, const Scene& scene, const Grid& grid
                    const std::function<bool(double)>& progress = {});
 
 // Reads and checks every count, offset, id and the checksum. Throws InputError naming the path and the byte offset
-// for a truncated, corrupt or newer-version file.
-GridFile readGridFile(const std::string& path);
+// for a truncated, corrupt or newer-version file. `progress`, when given, is asked with a fraction in [0, 1] at least
+// every 2^16 cells decoded; returning false cancels: vox::Error "NAME: reading cancelled" (Ctrl-C in libvox.load).
+GridFile readGridFile(const std::string& path, const std::function<bool(double)>& progress = {});
 
 // The checksum of docs/grid-format.md over a payload (the bytes after the 32-byte header).
 uint64_t gridChecksum(const char* payload, size_t size);
@@ -49,7 +50,10 @@ uint64_t gridChecksum(const char* payload, size_t size);
 // as voxelizeScene and decodeGridFile make it): version 3's encoder reads each cell's ids. Version 0: the one
 // gridFileVersionFor names. It encodes what it is given (tests make bad files with it); the writers of real
 // output (writeGridFile, pickling) call checkGridBeforeWrite first.
-std::string encodeGridFile(const Scene& scene, const Grid& grid, uint32_t version = 0);
-GridFile decodeGridFile(const std::string& bytes, const std::string& name);
+// `progress` as writeGridFile's (pickling's Ctrl-C).
+std::string encodeGridFile(const Scene& scene, const Grid& grid, uint32_t version = 0,
+                           const std::function<bool(double)>& progress = {});
+GridFile decodeGridFile(const std::string& bytes, const std::string& name,
+                        const std::function<bool(double)>& progress = {});
 
 }  // namespace vox

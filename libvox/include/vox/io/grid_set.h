@@ -182,7 +182,7 @@ GridFile readGridSet(const std::string& path);
 // Whether the file at `path` starts with the manifest's magic. Throws InputError when it cannot be read.
 bool isGridSet(const std::string& path);
 // readGridSet for a manifest, readGridFile otherwise: what the tools load. A brick file named directly is refused
-// with a message naming its manifest's role.
-GridFile readGridOrSet(const std::string& path);
+// with a message naming its manifest's role. `progress`: readGridFile's (a set is read without it).
+GridFile readGridOrSet(const std::string& path, const std::function<bool(double)>& progress = {});
 
 }  // namespace vox

@@ -486,7 +486,11 @@ void writeGridFile(const std::string& path, const Scene& scene, const Grid& grid
 
 GridFile readGridFile(const std::string& path, const std::function<bool(double)>& progress) {
   // readInputFile refuses non-regular files and sizes the memory budget cannot hold, before reading them whole.
-  return decodeGridFile(readInputFile(path, "grid file"), path, progress);
+  const auto part = [&](double from, double to) -> std::function<bool(double)> {
+    if (!progress) return {};
+    return [&progress, from, to](double f) { return progress(from + (to - from) * f); };
+  };
+  return decodeGridFile(readInputFile(path, "grid file", part(0, 0.3)), path, part(0.3, 1));
 }
 
 }  // namespace vox

@@ -61,14 +61,35 @@ void readAll(const OpenInput& in, char* into, const std::string& path) {
 
 }  // namespace
 
-std::string readInputFile(const std::string& path, const char* what) {
+namespace {
+
+// readAll, asking `progress` after every 32 MiB piece when there is one.
+void readAllAsking(const OpenInput& in, char* data, const std::string& path,
+                   const std::function<bool(double)>& progress) {
+  if (!progress) {
+    readAll(in, data, path);
+    return;
+  }
+  constexpr size_t kPiece = size_t{32} << 20;
+  for (size_t at = 0; at < in.size; at += kPiece) {
+    const size_t want = std::min(kPiece, in.size - at);
+    const size_t got = std::fread(data + at, 1, want, in.file.get());
+    if (std::ferror(in.file.get()) != 0 || got != want)
+      fail<InputError>(path, ": read error after ", at + got, " bytes");
+    if (!progress(double(at + got) / double(in.size))) fail<Error>(path, ": reading cancelled");
+  }
+}
+
+}  // namespace
+
+std::string readInputFile(const std::string& path, const char* what, const std::function<bool(double)>& progress) {
   const OpenInput in = openInput(path, what, SIZE_MAX);
   // Reserved on huge pages before the first touch: a large file's bytes otherwise cost a 4 KiB page fault per page.
   std::string bytes;
   bytes.reserve(in.size);
   adviseHugePages(bytes.data(), bytes.capacity());
   bytes.resize(in.size);
-  readAll(in, bytes.data(), path);
+  readAllAsking(in, bytes.data(), path, progress);
   return bytes;
 }
 
@@ -76,18 +97,7 @@ HugeBuffer readInputBytes(const std::string& path, const char* what, size_t maxB
                           const std::function<bool(double)>& progress) {
   const OpenInput in = openInput(path, what, maxBytes);
   HugeBuffer bytes(in.size);
-  if (!progress) {
-    readAll(in, bytes.data(), path);
-    return bytes;
-  }
-  constexpr size_t kPiece = size_t{32} << 20;
-  for (size_t at = 0; at < in.size; at += kPiece) {
-    const size_t want = std::min(kPiece, in.size - at);
-    const size_t got = std::fread(bytes.data() + at, 1, want, in.file.get());
-    if (std::ferror(in.file.get()) != 0 || got != want)
-      fail<InputError>(path, ": read error after ", at + got, " bytes");
-    if (!progress(double(at + got) / double(in.size))) fail<Error>(path, ": reading cancelled");
-  }
+  readAllAsking(in, bytes.data(), path, progress);
   return bytes;
 }
 

@@ -17,7 +17,9 @@ namespace vox {
 // Reads a whole regular file. Throws InputError naming `path` when it is missing, a folder, a FIFO or device
 // (which could block forever or never end), unreadable, or larger than the memory budget allows (LimitError).
 // `what` names the file's role in messages ("scene file", "grid file").
-std::string readInputFile(const std::string& path, const char* what);
+// `progress`, when given, is asked after every 32 MiB piece; returning false cancels (vox::Error "PATH: reading
+// cancelled").
+std::string readInputFile(const std::string& path, const char* what, const std::function<bool(double)>& progress = {});
 
 // The same, into a buffer on huge pages, whole and not zeroed first (huge_buffer.h): for the large texts the
 // importers parse (OBJ, PLY), where the string's page faults and TLB misses cost more than the parse. A file of more

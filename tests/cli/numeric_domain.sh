@@ -45,5 +45,18 @@ for flag in --sdf --fraction; do
     fail "$flag, side 16 at 1e16: exit $status: $(cat "$tmp/err")"
 done
 
+# A closed cube of side 1e150 with --fraction: its volume, 1e450, is beyond a double, so vox-info gives the volumes in
+# cells (the probe of issue 45 saw "fraction_volume: inf (the scene's own volume: -nan)"); 1 keeps world units.
+for side in 1e150 1; do
+  cube "$side" 0 >"$tmp/v.obj"
+  "$build/vox-voxelize" "$tmp/v.obj" -o "$tmp/v.vgrid" --grid 4 4 4 --fraction -q 2>"$tmp/err" || fail "$side: $(cat "$tmp/err")"
+  "$build/vox-info" "$tmp/v.vgrid" >"$tmp/info" 2>"$tmp/err" || fail "$side fraction: vox-info: $(cat "$tmp/err")"
+  want='^fraction_volume: 1 (the scene.s own volume: 1)$'
+  [ "$side" = 1 ] || want='^fraction_volume: 64 cells (the scene.s own volume: 64 cells; in world units'
+  grep -q "$want" "$tmp/info" || fail "$side fraction: $(grep fraction "$tmp/info")"
+  "$build/vox-info" "$tmp/v.vgrid" --json >"$tmp/info" 2>"$tmp/err" || fail "$side fraction: vox-info --json"
+  grep -qiE ': -?(inf|nan)' "$tmp/info" && fail "$side fraction: inf or nan in the JSON: $(grep fractions "$tmp/info")"
+done
+
 [ "$failures" = 0 ] && echo "numeric_domain: all passed"
 exit "$failures"

@@ -50,7 +50,9 @@ def case_reports(request):
     pool.shutdown(cancel_futures=True)
 
 
-@pytest.mark.parametrize("case", [pytest.param(c, marks=pytest.mark.xfail(reason=NOT_YET[c], strict=True))
+# Not strict: whether the one unchecked call of such a case outlasts the allowance depends on where the signal lands
+# (save_gltf passed once in three runs); bench/python_ctrl_c.py measures it.
+@pytest.mark.parametrize("case", [pytest.param(c, marks=pytest.mark.xfail(reason=NOT_YET[c], strict=False))
                                   if c in NOT_YET else c for c in CASES])
 def test_ctrl_c_stops_long_call(case, case_reports):
     """KeyboardInterrupt, well inside 2 s, from a call that would have run on for seconds; no temporary file left,

@@ -104,3 +104,22 @@ def test_far_points_right_or_refused():
             g.distance([[0, x, 0]])
     with pytest.raises(libvox.InputError, match=r"sdf: cell centres reach 7.5e\+299 \(bounds 1e\+300\)"):
         libvox.sdf((V, F), dims=(4, 4, 4), bounds=((-1e300,) * 3, (1e300,) * 3))
+
+
+def test_an_empty_band_saves_loads_and_pickles(tmp_path):
+    """A band that reaches no cell centre (bounds inside the cube, further than HALF cells from its faces) is a legal
+    grid: it saved as "0 cells and 0 values at half-width 2; not written" (a RuntimeError) before (probe of issue
+    45). Now every writer takes it and every reader gives it back."""
+    from conftest import box
+    v, f = box((0, 0, 0), (1, 1, 1))
+    g = libvox.voxelize((v, f), dims=8, sdf=2, bounds=((0.25,) * 3, (0.75,) * 3))
+    assert g.sdf_half_width == 2 and len(g.sdf[1]) == 0
+    for c in (pickle.loads(pickle.dumps(g)), libvox.load(_save(g, tmp_path / "g.vgrid"))):
+        assert c.sdf_half_width == 2 and len(c.sdf[1]) == 0 and np.array_equal(c.indices, g.indices)
+    npz = np.load(_save(g, tmp_path / "g.npz"))
+    assert np.isnan(npz["sdf"]).all()
+
+
+def _save(g, path):
+    g.save(str(path))
+    return str(path)

@@ -5,6 +5,7 @@
 
 #include "vox/core/cell_range.h"
 #include "vox/core/error.h"
+#include "vox/core/exact_number.h"
 
 namespace vox {
 
@@ -118,11 +119,13 @@ void checkGridBeforeWrite(const Grid& grid, const std::string& what) {
   if (grid.cellStart.size() != grid.cellKeys.size() + 1 || grid.cellStart.back() != grid.primIds.size())
     fail<Error>(what, ": the cell table's starts do not match its cells; not written");
   checkSolidRuns(grid.solidRuns, cells, what);
-  if (grid.sdfKeys.size() != grid.sdfValues.size() || (grid.sdfHalfWidth == 0) != grid.sdfKeys.empty())
+  // A band may be empty (bounds or a half-width that reach no cell centre within HALF): the file says so.
+  if (grid.sdfKeys.size() != grid.sdfValues.size() || (grid.sdfHalfWidth == 0 && !grid.sdfKeys.empty()))
     fail<Error>(what, ": the distance band has ", grid.sdfKeys.size(), " cells and ", grid.sdfValues.size(),
-                " values at half-width ", grid.sdfHalfWidth, "; not written");
+                " values at half-width ", exactNumber(grid.sdfHalfWidth), "; not written");
   if (grid.sdfHalfWidth != 0 && !(grid.sdfHalfWidth > 0 && grid.sdfHalfWidth <= 64))
-    fail<Error>(what, ": distance band half-width ", grid.sdfHalfWidth, " is outside (0, 64]; not written");
+    fail<Error>(what, ": distance band half-width ", exactNumber(grid.sdfHalfWidth),
+                " is outside (0, 64]; not written");
   if (const size_t i = firstBadKey(grid.sdfKeys, cells); i < grid.sdfKeys.size())
     fail<Error>(what, ": distance band cell key ", grid.sdfKeys[i], " is repeated, out of order or outside the ", cells,
                 " cells; not written");

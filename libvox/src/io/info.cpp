@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "vox/core/compensated_sum.h"
+#include "vox/core/power_of_two_frame.h"
 #include "vox/io/grid_set.h"
 
 namespace vox {
@@ -102,11 +103,16 @@ double sceneVolume(const Scene& sc, double* meshVolume = nullptr) {
   return v.value();
 }
 
-// What --sdf and --fraction stored: the band's size and range; the fractions' volume beside the scene's own.
+// What --sdf and --fraction stored: the band's size and range; the fractions' volume beside the scene's own, in
+// world units and in cells. The cells' figures are computed in the power-of-two frame of the scene and the bounds
+// (vox/core/power_of_two_frame.h), so they stay finite where a world volume does not fit a double (a cube of side
+// 1e150 has a volume of 1e450).
 struct DistanceSummary {
   double bandMin = 0, bandMax = 0;
   double fractionVolume = 0, sceneVolume = 0;
   double meshVolume = 0;  // the triangles' signed volume: negative when they face inward
+  double fractionCells = 0, sceneCells = 0;
+  bool worldFits() const { return std::isfinite(fractionVolume) && std::isfinite(sceneVolume); }
 };
 
 DistanceSummary summarizeDistances(const Scene& sc, const Grid& g, uint64_t solidCells) {
@@ -116,13 +122,20 @@ DistanceSummary summarizeDistances(const Scene& sc, const Grid& g, uint64_t soli
     d.bandMax = *std::max_element(g.sdfValues.begin(), g.sdfValues.end());
   }
   if (!g.fractions.empty()) {
-    double cell = 1;
-    for (int a = 0; a < 3; ++a) cell *= (g.bounds.hi[a] - g.bounds.lo[a]) / g.dims[a];
+    const PowerOfTwoFrame frame = fractionFrame(sc, g.bounds);
+    const Box framed = frame.toFrame(g.bounds);
+    double cell = 1, framedCell = 1;
+    for (int a = 0; a < 3; ++a) {
+      cell *= (g.bounds.hi[a] - g.bounds.lo[a]) / g.dims[a];
+      framedCell *= (framed.hi[a] - framed.lo[a]) / g.dims[a];
+    }
     CompensatedSum sum;
     sum.add(double(solidCells));
     for (double f : g.fractions) sum.add(f);
-    d.fractionVolume = sum.value() * cell;
+    d.fractionCells = sum.value();
+    d.fractionVolume = d.fractionCells * cell;
     d.sceneVolume = sceneVolume(sc, &d.meshVolume);
+    d.sceneCells = sceneVolume(sceneInFrame(sc, frame)) / framedCell;
   }
   return d;
 }
@@ -133,12 +146,17 @@ void plainDistances(std::ostream& out, const InfoSource& in) {
   if (g.sdfHalfWidth > 0)
     out << "distance_band: " << g.sdfKeys.size() << " cells within " << num(g.sdfHalfWidth)
         << " cell widths, signed distances " << num(d.bandMin) << " to " << num(d.bandMax) << "\n";
-  if (!g.fractions.empty())
-    out << "fraction_volume: " << num(d.fractionVolume) << " (the scene's own volume: " << num(d.sceneVolume)
-        << (d.meshVolume < 0 ? "; its triangles face inward (negative signed volume " + num(d.meshVolume) +
-                                   "), and the fractions count the solid they enclose all the same"
-                             : std::string())
+  if (!g.fractions.empty()) {
+    if (d.worldFits())
+      out << "fraction_volume: " << num(d.fractionVolume) << " (the scene's own volume: " << num(d.sceneVolume);
+    else
+      out << "fraction_volume: " << num(d.fractionCells) << " cells (the scene's own volume: " << num(d.sceneCells)
+          << " cells; in world units these volumes are beyond a double";
+    out << (d.meshVolume < 0
+                ? "; its triangles face inward, and the fractions count the solid they enclose all the same"
+                : std::string())
         << ")\n";
+  }
 }
 
 void jsonDistances(std::ostream& out, const InfoSource& in) {
@@ -148,7 +166,9 @@ void jsonDistances(std::ostream& out, const InfoSource& in) {
     out << "  \"distance_band\": {\"cells\": " << g.sdfKeys.size() << ", \"half_width\": " << num(g.sdfHalfWidth)
         << ", \"min\": " << num(d.bandMin) << ", \"max\": " << num(d.bandMax) << "},\n";
   if (!g.fractions.empty())
-    out << "  \"fractions\": {\"volume\": " << num(d.fractionVolume) << ", \"scene_volume\": " << num(d.sceneVolume)
+    out << "  \"fractions\": {\"volume\": " << (d.worldFits() ? num(d.fractionVolume) : "null")
+        << ", \"scene_volume\": " << (d.worldFits() ? num(d.sceneVolume) : "null")
+        << ", \"volume_cells\": " << num(d.fractionCells) << ", \"scene_volume_cells\": " << num(d.sceneCells)
         << ", \"mesh_faces_inward\": " << (d.meshVolume < 0 ? "true" : "false") << "},\n";
 }
 

@@ -15,7 +15,8 @@ namespace vox::voxelize_tool {
 void checkDistanceFlags(const Options& opt) {
   if (opt.sdf) checkSdfHalfWidth(*opt.sdf, "--sdf");
   if ((opt.sdf || opt.fraction) && !opt.bricks.empty())
-    fail<UsageError>("--sdf and --fraction write a single grid file; grid sets (--bricks) hold no distances or fractions");
+    fail<UsageError>(
+        "--sdf and --fraction write a single grid file; grid sets (--bricks) hold no distances or fractions");
 }
 
 VoxelizeOptions cubicCellsForDistances(const Options& opt, const Scene& scene, VoxelizeOptions vo) {

@@ -28,6 +28,7 @@ LATENCY_LIMIT = 2.0
 # Calls without cancellation yet.
 NOT_YET = {
     "save_gltf": "tinygltf builds the .gltf (its buffer base64-encoded) in one call: 2.7 s past Ctrl-C",
+    "save_glb": "tinygltf writes the .glb in one call: up to 2.3 s past Ctrl-C (bench/python_ctrl_c.py)",
 }
 
 
@@ -51,7 +52,7 @@ def case_reports(request):
 
 
 # Not strict: whether the one unchecked call of such a case outlasts the allowance depends on where the signal lands
-# (save_gltf passed once in three runs); bench/python_ctrl_c.py measures it.
+# (save_gltf passed once in three runs, save_glb failed once in four); bench/python_ctrl_c.py measures it.
 @pytest.mark.parametrize("case", [pytest.param(c, marks=pytest.mark.xfail(reason=NOT_YET[c], strict=False))
                                   if c in NOT_YET else c for c in CASES])
 def test_ctrl_c_stops_long_call(case, case_reports):

@@ -246,42 +246,27 @@ void checkNumericDomainOfPlan(const Scene& scene, const VoxelizeOptions& options
 
 namespace {
 
-// The grid's bounds scaled into a frame for the span of a computation, and back whatever happens.
-class FramedBounds {
- public:
-  FramedBounds(Grid& grid, const PowerOfTwoFrame& frame) : grid_(grid), world_(grid.bounds) {
-    grid.bounds = frame.toFrame(world_);
-  }
-  ~FramedBounds() { grid_.bounds = world_; }
-  FramedBounds(const FramedBounds&) = delete;
-  FramedBounds& operator=(const FramedBounds&) = delete;
-
- private:
-  Grid& grid_;
-  Box world_;
-};
-
-void storeFramedSignedDistances(Grid& grid, const Scene& scene, const SdfOptions& options, bool filled);
+void storeFramedSignedDistances(Grid& grid, const Scene& scene, const SdfOptions& options);
 
 }  // namespace
 
 // The band is computed in the scene's power-of-two frame (docs/limits.md "Numeric domain"): a scene's band at scale
 // 2^k is its band at scale 1 times 2^k, bit for bit, and no squared distance overflows or underflows.
-void storeSignedDistances(Grid& grid, const Scene& scene, const SdfOptions& options, bool filled) {
+void storeSignedDistances(Grid& grid, const Scene& scene, const SdfOptions& options, bool /*filled*/) {
   checkSdfHalfWidth(options.halfWidth, "--sdf");
   const PowerOfTwoFrame frame = sceneFrame(scene);
   checkNumericDomain(scene, grid.bounds, grid.dims, frame, true, "--sdf");
-  if (frame.identity()) return storeFramedSignedDistances(grid, scene, options, filled);
+  if (frame.identity()) return storeFramedSignedDistances(grid, scene, options);
   {
     const FramedBounds framed(grid, frame);
-    storeFramedSignedDistances(grid, sceneInFrame(scene, frame), options, filled);
+    storeFramedSignedDistances(grid, sceneInFrame(scene, frame), options);
   }
   for (double& v : grid.sdfValues) v = frame.toWorld(v);
 }
 
 namespace {
 
-void storeFramedSignedDistances(Grid& grid, const Scene& scene, const SdfOptions& options, bool /*filled*/) {
+void storeFramedSignedDistances(Grid& grid, const Scene& scene, const SdfOptions& options) {
   // The signs come from InsideTest, not from the fill: nothing to fill on the side.
   SdfBand band = signedDistanceBand(grid, scene, options);
   grid.sdfHalfWidth = options.halfWidth;

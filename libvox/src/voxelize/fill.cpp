@@ -763,16 +763,8 @@ FillReport fillSolid(Grid& grid, const Scene& scene, const FillOptions& options)
   bool useFrame = !frame.identity();
   for (int a = 0; a < 3; ++a) useFrame = useFrame && (grid.bounds.hi[a] - grid.bounds.lo[a]) / grid.dims[a] >= DBL_MIN;
   if (!useFrame) return framedFillSolid(grid, scene, options);
-  const Box world = grid.bounds;
-  grid.bounds = frame.toFrame(world);
-  try {
-    const FillReport report = framedFillSolid(grid, sceneInFrame(scene, frame), options);
-    grid.bounds = world;
-    return report;
-  } catch (...) {
-    grid.bounds = world;
-    throw;
-  }
+  const FramedBounds framed(grid, frame);
+  return framedFillSolid(grid, sceneInFrame(scene, frame), options);
 }
 
 static FillReport framedFillSolid(Grid& grid, const Scene& scene, const FillOptions& options) {

@@ -51,6 +51,22 @@ PowerOfTwoFrame fractionFrame(const Scene& scene, const Box& bounds);
 // centre and radius.
 Scene sceneInFrame(const Scene& scene, const PowerOfTwoFrame& frame);
 
+// The grid's bounds scaled into `frame` for the span of a computation on the caller's grid (its cells and runs
+// unchanged), and back to world units whatever happens: the band and the fill.
+class FramedBounds {
+ public:
+  FramedBounds(Grid& grid, const PowerOfTwoFrame& frame) : grid_(grid), world_(grid.bounds) {
+    grid.bounds = frame.toFrame(world_);
+  }
+  ~FramedBounds() { grid_.bounds = world_; }
+  FramedBounds(const FramedBounds&) = delete;
+  FramedBounds& operator=(const FramedBounds&) = delete;
+
+ private:
+  Grid& grid_;
+  Box world_;
+};
+
 // Throws InputError, one line prefixed by `what`, when the grid cannot give exact-or-bounded distances, signs or
 // fractions in `frame`: a coordinate of the scene or the bounds beyond +-2^kMaxCoordinateExponent; cell centres
 // beyond +-2^kFrameReachExponent in the frame (`checkReach`); a cell edge below the smallest normal double (cell

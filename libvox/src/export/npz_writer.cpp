@@ -2,7 +2,9 @@
 
 #include <zlib.h>
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -37,15 +39,23 @@ void put(std::string& s, T v) {
 }
 
 // A zip archive of stored entries written in one pass: each entry's CRC and size are known before its local header
-// (the entry is built in memory first), and the central directory follows the last entry.
+// (the entry is built in memory first), and the central directory follows the last entry. The data is checksummed
+// and written in chunks, each reported to `progress` (a fraction of `expectedBytes`, each byte counted twice), so
+// that Ctrl-C stops a save of gigabytes within a chunk (issue 45: 0.55 s past the signal with one call per array).
 class ZipWriter {
  public:
-  explicit ZipWriter(std::ostream& out) : out_(out) {}
+  ZipWriter(std::ostream& out, uint64_t expectedBytes, const std::function<void(double)>& progress)
+      : out_(out), expected_(2.0 * double(expectedBytes)), progress_(progress) {}
 
   void add(const std::string& name, const std::string& header, const void* data, uint64_t bytes) {
     uLong crc = crc32(0L, Z_NULL, 0);
     crc = crc32_z(crc, reinterpret_cast<const Bytef*>(header.data()), header.size());
-    crc = crc32_z(crc, reinterpret_cast<const Bytef*>(data), bytes);
+    const auto* bytesIn = static_cast<const Bytef*>(data);
+    for (uint64_t at = 0; at < bytes; at += kChunk) {
+      const uint64_t n = std::min(kChunk, bytes - at);
+      crc = crc32_z(crc, bytesIn + at, n);
+      report(n);
+    }
     const uint64_t size = header.size() + bytes;
     Entry e{name, uint32_t(crc), uint32_t(size), uint32_t(offset_)};
     std::string local;
@@ -54,7 +64,11 @@ class ZipWriter {
     local += name;
     write(local.data(), local.size());
     write(header.data(), header.size());
-    write(data, bytes);
+    for (uint64_t at = 0; at < bytes; at += kChunk) {
+      const uint64_t n = std::min(kChunk, bytes - at);
+      write(static_cast<const char*>(data) + at, n);
+      report(n);
+    }
     entries_.push_back(e);
   }
 
@@ -104,12 +118,21 @@ class ZipWriter {
     put<uint16_t>(s, uint16_t(e.name.size()));
     put<uint16_t>(s, 0);
   }
+  static constexpr uint64_t kChunk = uint64_t(16) << 20;
+
+  void report(uint64_t n) {
+    done_ += double(n);
+    if (progress_) progress_(std::min(1.0, done_ / expected_));
+  }
   void write(const void* data, uint64_t n) {
     out_.write(static_cast<const char*>(data), std::streamsize(n));
     offset_ += n;
   }
 
   std::ostream& out_;
+  const double expected_;
+  const std::function<void(double)>& progress_;
+  double done_ = 0;
   uint64_t offset_ = 0;
   std::vector<Entry> entries_;
 };
@@ -134,22 +157,19 @@ uint64_t writeNpz(std::ostream& out, const Grid& grid, const std::function<void(
                      total >> 20, " MiB, over the 4 GiB of the zip format; export .vdb (sparse) instead");
   checkMemory(double(cells) * (sdf || fraction ? 8 : 1), "npz export", "one dense array");
   const std::vector<uint64_t> shape{grid.dims[0], grid.dims[1], grid.dims[2]};
-  ZipWriter zip(out);
+  ZipWriter zip(out, total, progress);
   {
     std::vector<uint8_t> occupancy(cells, 0), solid(cells, 0);
     for (uint64_t key : grid.cellKeys) occupancy[key] = 1;
     for (const CellRun& r : grid.solidRuns) std::fill_n(solid.begin() + r.first, r.count, uint8_t(1));
     addArray(zip, "occupancy", "|u1", shape, true, occupancy);
-    if (progress) progress(0.2);
     addArray(zip, "solid", "|u1", shape, true, solid);
   }
-  if (progress) progress(0.4);
   if (sdf) {
     std::vector<double> values(cells, std::numeric_limits<double>::quiet_NaN());
     for (size_t b = 0; b < grid.sdfKeys.size(); ++b) values[grid.sdfKeys[b]] = grid.sdfValues[b];
     addArray(zip, "sdf", "<f8", shape, true, values);
   }
-  if (progress) progress(0.7);
   if (fraction) {
     std::vector<double> values(cells, 0.0);
     for (const CellRun& r : grid.solidRuns) std::fill_n(values.begin() + r.first, r.count, 1.0);

@@ -10,14 +10,11 @@
 // Ties are broken by "inside means d < level", so no vertex lies on the level. The cost is more, thinner
 // triangles (about twice marching cubes').
 //
-// Which cubes: the band holds the centres with |d| <= HALF h; a centre outside the band is more than HALF h from the
-// surface, so when |level| <= HALF h - D (D the cell diagonal; largestSurfaceLevel) every centre of a cube that has
-// one outside the band is on that centre's side of the level, and the level crosses only cubes entirely in the
-// band. Those are the cubes whose lowest corner is a band cell and whose other seven corners are, found by walking
-// four rows of the band at once. Beyond the grid every centre is outside, and the cubes straddling the grid's
-// boundary close the surface; their corners inside the grid but outside the band take the side of the nearest band
-// cell along their row (same argument), or of a neighbouring row where a row has none (a breadth-first walk over
-// the rows).
+// Which cubes: every cube of the lattice padded by one point whose corners are not all on one side, found row by
+// row (four rows of cells at once, level_surface.h says how centres outside the band get a side). For a continuous
+// field and |level| <= HALF h - D those are exactly the cubes with all 8 centres in the band and the cubes closing
+// the surface on the grid's bounds, but marching whatever the sides say keeps the output closed for any band,
+// including the jumps of an open mesh's sign.
 #include "vox/export/level_surface.h"
 
 #include <algorithm>

@@ -12,8 +12,8 @@
 namespace vox {
 
 struct LevelSurfaceStats {
-  size_t cubes = 0;         // cubes of 8 cell centres visited (all 8 in the band, or closing the grid's boundary)
-  size_t capTriangles = 0;  // triangles of the closing cap on the grid's bounds (the level set leaving the grid)
+  size_t cubes = 0;         // cubes of 8 cell centres with corners on both sides (those that make faces)
+  size_t capTriangles = 0;  // triangles of cubes reaching beyond the grid (the cap on the grid's bounds)
   double seconds = 0;
 };
 
@@ -33,23 +33,27 @@ double surfaceHalfWidth(const Grid& grid, double level);
 // tetrahedra around its diagonal from the low to the high corner, the same split in every cube, so neighbouring
 // cubes agree on each shared face and the level set of the piecewise-linear interpolant is a closed 2-manifold
 // (no ambiguous case exists). A centre is inside when its distance is < level.
-//  - Cubes: those whose 8 centres are all in the band; cubes with a centre outside it make no face (the level
-//    cannot cross them: see largestSurfaceLevel). Cells beyond the grid count as outside, so where the level set
-//    leaves the grid it is closed by a cap on the grid's bounds (its vertices lie on the bounds, halfway between
-//    the last centre and the next one beyond); the sign of a boundary cell outside the band is that of the
-//    nearest band cell in its row along x (or, for a row without band cells, of a neighbouring row's).
+//  - Sides: a band centre's from its distance; a centre outside the band takes the side of the band cell before it
+//    in its row along x (else the one after it; a row without band cells takes a neighbouring row's); cells beyond
+//    the grid are outside. Every cube of the grid padded by one cell whose corners are not all on one side is
+//    marched, so the output is closed and manifold for any band. For a continuous field (a closed mesh) and
+//    |level| <= largestSurfaceLevel, a centre outside the band is more than a cell diagonal beyond the level, so
+//    only cubes with all 8 centres in the band make faces, besides the cap closing the surface on the grid's bounds
+//    where it leaves the grid (vertices halfway between the last centre and the next one beyond). An open mesh's
+//    sign jumps where its winding number crosses 1/2 (the caps of its holes); where that is farther than the band
+//    from every triangle, the cap's faces cross cells outside the band, placed by those rows' nearest band cells.
 //  - Vertices: one per lattice edge (axis, face diagonal or cube diagonal) whose ends lie on both sides, linearly
-//    interpolated, t = (level - d0) / (d1 - d0), clamped to [2^-10, 1 - 2^-10] of the edge so that no two vertices
-//    coincide and no triangle has zero area even after float32 output. For a vertex on an edge of length L with
-//    end values d0 < level <= d1, 1-Lipschitz distances give |d(vertex) - level| <= max(t, 1 - t) (L - (d1 - d0))
-//    + 2^-10 L < L <= D (the cell diagonal); on a smooth surface the error is second order (see the docs).
+//    interpolated between band values, t = (level - d0) / (d1 - d0), clamped to [2^-10, 1 - 2^-10] of the edge so
+//    that no two vertices coincide and no triangle has zero area even after float32 output; halfway along edges
+//    with an end outside the band or beyond the grid. For a vertex on an edge of length L whose ends have
+//    d0 < level <= d1 (continuous field), 1-Lipschitz distances give |d(vertex) - level| <=
+//    max(t, 1 - t) (L - (d1 - d0)) + 2^-10 L < L <= D (the cell diagonal).
 //  - Output: triangles (faceStart steps of 3), counter-clockwise seen from outside (normals point to increasing
 //    distance), no colours; vertices ordered by lattice edge, faces by cube: the result does not depend on threads.
-// Throws InputError when the grid has no distances ("... no signed distances: voxelize with --sdf"), when |level|
-// exceeds largestSurfaceLevel (the message gives the allowed range and the --sdf HALF that would allow `level`),
-// when level is not finite, or when the band is inconsistent (the level crosses a cube with a centre outside the
-// band, which no band libvox computes has); LimitError beyond 2^32 - 1 vertices. `progress` (may be empty) is
-// called with the fraction done; returning false throws Error("surface cancelled").
+// Throws InputError when the grid has no distances ("... no signed distances: voxelize it with --sdf"), when |level|
+// exceeds largestSurfaceLevel (the message gives the allowed range and the --sdf HALF that would allow `level`) or
+// is not finite; LimitError beyond 2^32 - 1 vertices or triangles. `progress` (may be empty) is called with the
+// fraction done; returning false throws Error("surface cancelled").
 VoxelMesh extractLevelSurface(const Grid& grid, double level, LevelSurfaceStats* stats = nullptr,
                               const std::function<bool(double)>& progress = {});
 

@@ -402,7 +402,26 @@ py::tuple surfaceOfSource(const py::object& source, const py::object& resolution
     const vox::Scene& scene = src.load([&](double) { return interrupt.poll(0); });
     if (request.pitch) applyPitch(*request.pitch, scene, vo);
     return namedAfter(src, [&] {
+      const bool userBounds = vo.bounds.has_value();
       vo = vox::withCubicCells(scene, vo);
+      if (!userBounds) {
+        // Without bounds, room around the scene: two cells, and the level's width for a grown surface, on every
+        // side (the same cubic cells), so that the surface is not cut flat at the scene's own bounds.
+        const vox::Grid plan = vox::planGrid(scene, vo);
+        vox::Box b = plan.bounds;
+        std::array<uint32_t, 3> d = plan.dims;
+        for (int a = 0; a < 3; ++a) {
+          const double h = (b.hi[a] - b.lo[a]) / double(d[a]);
+          const double cells = std::ceil(std::max(lvl, 0.0) / h) + 2;
+          if (!(cells < double(vox::kMaxCellsPerAxis))) vox::fail<vox::UsageError>("level ", lvl, " is too large");
+          b.lo.at(a) -= cells * h;
+          b.hi.at(a) += cells * h;
+          d[a] = uint32_t(std::min<double>(d[a] + 2 * cells, vox::kMaxCellsPerAxis));
+        }
+        vo.bounds = b;
+        vo.dims = d;
+        vo.resolution.reset();
+      }
       vox::checkNumericDomainOfPlan(scene, vo, true, false);
       vox::Grid g = vox::voxelizeScene(scene, vo);
       vox::SdfOptions so;
@@ -432,7 +451,8 @@ the level set d = level (world units) of the exact signed distance (negative ins
 self-intersecting and inconsistently oriented meshes come out closed), linearly interpolated between cell centres.
 
 source, resolution, dims, pitch, bounds, threads and progress as for voxelize (with a resolution, cells exactly
-cubic). half_width: the band in cell widths, in (0, 64]; default the smallest that holds the level (at least 3).
+cubic), and without bounds the grid gets two cells (and the level's width) of room on every side, so that the
+surface is not cut at the scene's bounds. half_width: the band in cell widths, in (0, 64]; default the smallest that holds the level (at least 3).
 Raises InputError when |level| exceeds what the band holds (half_width * h - cell diagonal), UsageError for bad
 options, TypeError for wrong types; as voxelize otherwise.
 )doc");

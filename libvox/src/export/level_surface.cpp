@@ -19,11 +19,13 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <deque>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "vox/core/error.h"
@@ -329,6 +331,12 @@ void marchAllCubes(const Grid& grid, const Band& band, double level, Marcher& ou
 
 namespace level_surface_impl {
 
+// A number in a message, shortest round trip: a range must not be rounded into a contradiction with the value.
+std::string exact(double x) {
+  char buf[32];
+  return std::string(buf, std::to_chars(buf, buf + sizeof buf, x).ptr);
+}
+
 // The smallest cell edge h and the cell diagonal D.
 std::array<double, 2> cellScales(const Grid& grid) {
   double smallest = INFINITY, diagonal = 0;
@@ -359,7 +367,8 @@ double surfaceHalfWidth(const Grid& grid, double level) {
   double half = std::max(3.0, (std::abs(level) + d) / h);
   for (int n = 0; n < 64 && largestLevel(grid, half) < std::abs(level); ++n) half = std::nextafter(half, INFINITY);
   if (half > 64 || largestLevel(grid, half) < std::abs(level))
-    fail<InputError>("surface level ", level, " is outside [", -largestLevel(grid, 64), ", ", largestLevel(grid, 64),
+    fail<InputError>("surface level ", exact(level), " is outside [", exact(-largestLevel(grid, 64)), ", ",
+                     exact(largestLevel(grid, 64)),
                      "], the levels a band of 64 cell widths (the widest) holds with a cell's diagonal to spare "
                      "at these cells");
   return half;
@@ -371,17 +380,21 @@ VoxelMesh extractLevelSurface(const Grid& grid, double level, LevelSurfaceStats*
   const auto start = std::chrono::steady_clock::now();
   if (grid.sdfHalfWidth == 0) fail<InputError>("the grid has no signed distances: voxelize it with --sdf");
   VOX_CHECK(grid.sdfKeys.size() == grid.sdfValues.size());
-  if (!std::isfinite(level)) fail<InputError>("surface level ", level, " is not a finite number");
+  if (!std::isfinite(level)) fail<InputError>("surface level ", exact(level), " is not a finite number");
   const double largest = largestSurfaceLevel(grid);
   if (!(std::abs(level) <= largest)) {
+    // The half-width to suggest, rounded up to thousandths and checked, so that following the advice works.
     const auto [h, d] = cellScales(grid);
-    const double needed = (std::abs(level) + d) / h;
+    double needed = std::ceil((std::abs(level) + d) / h * 1000) / 1000;
+    while (largestLevel(grid, needed) < std::abs(level) && needed <= 64) needed += 0.001;
+    const std::string advice = needed <= 64 ? "voxelize with --sdf " + exact(needed) + " or more"
+                                            : "no band (at most --sdf 64) holds it at these cells";
     if (largest < 0)
-      fail<InputError>("surface: the distance band (--sdf ", grid.sdfHalfWidth,
-                       ") is narrower than a cell's diagonal; voxelize with --sdf ", needed, " or more");
-    fail<InputError>("surface level ", level, " is outside [", -largest, ", ", largest,
-                     "], the levels the distance band (--sdf ", grid.sdfHalfWidth,
-                     ") holds with a cell's diagonal to spare; voxelize with --sdf ", needed, " or more");
+      fail<InputError>("surface: the distance band (--sdf ", exact(grid.sdfHalfWidth),
+                       ") is narrower than a cell's diagonal; ", advice);
+    fail<InputError>("surface level ", exact(level), " is outside [", exact(-largest), ", ", exact(largest),
+                     "], the levels the distance band (--sdf ", exact(grid.sdfHalfWidth),
+                     ") holds with a cell's diagonal to spare; ", advice);
   }
 
   LevelSurfaceStats stats;

@@ -2,8 +2,10 @@
 surface vertex for vertex; every vertex within the stated bound of the level by Grid.distance; errors."""
 import numpy as np
 import pytest
-from hypothesis import given, settings
-from hypothesis import strategies as st
+
+hypothesis = pytest.importorskip("hypothesis")
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
 
 import libvox
 from conftest import BUNNY_PLY, box, cli_voxelize, run_tool
@@ -104,7 +106,7 @@ def test_errors():
         libvox.surface(CUBE, resolution=8, level=100.0)
 
 
-@settings(max_examples=25, deadline=None)
+@settings(max_examples=25, derandomize=True, deadline=None, database=None)
 @given(
     lo=st.tuples(*[st.integers(-8, 8)] * 3),
     size=st.tuples(*[st.integers(1, 8)] * 3),

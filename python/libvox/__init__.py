@@ -23,6 +23,7 @@ from ._libvox import (
     render,
     save_image,
     sdf,
+    surface,
     voxelize,
     voxelize_batch,
 )
@@ -48,6 +49,7 @@ __all__ = [
     "render",
     "save_image",
     "sdf",
+    "surface",
     "voxelize",
     "voxelize_batch",
 ]

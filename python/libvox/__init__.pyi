@@ -76,6 +76,9 @@ class Grid:
         self, faces: str = "merged", color: str = "none", *, threads: Optional[_Int] = None
     ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int32], Optional[npt.NDArray[np.uint8]]]: ...
     def colors(self, mode: str = "material") -> npt.NDArray[np.uint8]: ...
+    def surface(
+        self, level: _Float = 0.0, *, threads: Optional[_Int] = None
+    ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]: ...
     def intersect(
         self,
         origins: _Array,
@@ -120,6 +123,18 @@ def sdf(
     threads: Optional[_Int] = None,
     progress: _Progress = False,
 ) -> npt.NDArray[np.float64]: ...
+def surface(
+    source: _Source,
+    *,
+    resolution: Optional[_Int] = None,
+    dims: Union[None, _Int, Sequence[_Int]] = None,
+    pitch: Union[None, _Float, Sequence[_Float]] = None,
+    bounds: Optional[_Array] = None,
+    level: _Float = 0.0,
+    half_width: Optional[_Float] = None,
+    threads: Optional[_Int] = None,
+    progress: _Progress = False,
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]: ...
 def voxelize_batch(
     sources: Iterable[_Source],
     resolution: _Int = 64,

@@ -25,6 +25,7 @@
 #include "vox/io/grid_file.h"
 #include "vox/distance/nearest.h"
 #include "vox/distance/sdf.h"
+#include "vox/export/voxel_mesh.h"
 #include "vox/trace/accel.h"
 
 namespace voxpy {
@@ -215,6 +216,8 @@ void bindSave(GridClass& grid);
 void bindRays(GridClass& grid);
 void bindRender(py::module_& m);
 void bindMesh(GridClass& grid);
+// (vertices (V, 3) float64, faces (F, 3) int64) of a level surface (Grid.surface, libvox.surface).
+py::tuple surfaceArrays(vox::VoxelMesh&& mesh);
 void bindBench(py::module_& m);
 void bindDistance(GridClass& grid);
 

@@ -1,6 +1,7 @@
 // Grid.mesh and Grid.colors: the voxel mesh and cell colours of vox-export as arrays.
 #include "binding.h"
 #include "vox/core/error.h"
+#include "vox/export/level_surface.h"
 #include "vox/export/voxel_mesh.h"
 
 namespace voxpy {
@@ -36,6 +37,19 @@ py::tuple mesh(PyGrid& self, const py::object& facesName, const py::object& colo
                         adoptVector<int32_t>(std::move(m.faceVertices), {nf, 3}), colors);
 }
 
+py::tuple surface(PyGrid& self, const py::object& level, const py::object& threads) {
+  const double lvl = floatArg(level, "level");
+  if (self.grid().sdfHalfWidth == 0)
+    vox::fail<vox::InputError>(
+        "surface(): the grid has no signed distances: voxelize it with sdf=HALF "
+        "(vox-voxelize --sdf)");
+  Interrupt interrupt;
+  vox::VoxelMesh m = runLong(interrupt, threadsArg(threads), [&] {
+    return vox::extractLevelSurface(self.grid(), lvl, nullptr, [&](double f) { return interrupt.poll(f); });
+  });
+  return surfaceArrays(std::move(m));
+}
+
 py::array_t<uint8_t> colors(PyGrid& self, const py::object& modeName) {
   const vox::ColorMode mode = enumArg(modeName, "mode", vox::parseColorMode);
   if (mode == vox::ColorMode::None) vox::fail<vox::UsageError>("mode: expected 'count' or 'material'");
@@ -48,7 +62,24 @@ py::array_t<uint8_t> colors(PyGrid& self, const py::object& modeName) {
 
 }  // namespace
 
+py::tuple surfaceArrays(vox::VoxelMesh&& m) {
+  const py::ssize_t nv = py::ssize_t(m.vertexCount()), nf = py::ssize_t(m.faceCount());
+  std::vector<int64_t> faces(m.faceVertices.begin(), m.faceVertices.end());
+  m.faceVertices = {};
+  return py::make_tuple(adoptVector<double>(std::move(m.positions), {nv, 3}),
+                        adoptVector<int64_t>(std::move(faces), {nf, 3}));
+}
+
 void bindMesh(GridClass& grid) {
+  grid.def("surface", &surface, py::arg("level") = 0.0, py::kw_only(), py::arg("threads") = py::none(), R"doc(
+The level set d = level (world units; 0 the surface, > 0 grown, < 0 shrunk) of the grid's signed distances
+(voxelize(..., sdf=HALF)) as a closed, two-manifold triangle mesh oriented outward, as vox-export --surface writes
+it: vertices (V, 3) float64 (world space, one per lattice edge the level crosses, distinct), faces (F, 3) int64,
+counter-clockwise seen from outside, none of zero area. Marching tetrahedra over the cell centres of the band;
+where the level set leaves the grid it is closed on the grid's bounds. |level| may be at most
+HALF * (smallest cell edge) - (cell diagonal). Raises InputError for a grid without distances (naming sdf=) or a
+level outside that range, TypeError for a level that is not a number.
+)doc");
   grid.def("mesh", &mesh, py::arg("faces") = "merged", py::arg("color") = "none", py::kw_only(),
            py::arg("threads") = py::none(), R"doc(
 The voxels (occupied and solid cells) as a triangle mesh, as vox-export builds it: vertices (V, 3) float64 on the

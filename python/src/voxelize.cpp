@@ -13,6 +13,7 @@
 #include "vox/core/memory_budget.h"
 #include "vox/distance/queries.h"
 #include "vox/distance/sdf.h"
+#include "vox/export/level_surface.h"
 #include "vox/volume/fractions.h"
 #include "vox/voxelize/fill.h"
 #include "vox/voxelize/voxelize.h"
@@ -381,9 +382,81 @@ py::object voxelizeBatch(const py::object& sources, const py::object& resolution
   return list;
 }
 
+// libvox.surface: voxelize with distances (a band wide enough for the level) and extract the level set.
+py::tuple surfaceOfSource(const py::object& source, const py::object& resolution, const py::object& dims,
+                          const py::object& pitch, const py::object& bounds, const py::object& level,
+                          const py::object& halfWidth, const py::object& threads, const py::object& progress) {
+  Source src = sourceArg(source, "source", "");
+  GridRequest request = gridRequest(resolution, dims, pitch, bounds, py::str("exact"));
+  vox::VoxelizeOptions& vo = request.options;
+  const double lvl = floatArg(level, "level");
+  std::optional<double> half;
+  if (!halfWidth.is_none()) {
+    half = floatArg(halfWidth, "half_width");
+    vox::checkSdfHalfWidth(*half, "half_width");
+  }
+  const auto nThreads = threadsArg(threads);
+  Interrupt interrupt(progressCallable(progress, "surface"));
+  vo.progress = [&](double f) { return interrupt.poll(0.2 * f); };
+  vox::VoxelMesh mesh = runLong(interrupt, nThreads, [&] {
+    const vox::Scene& scene = src.load([&](double) { return interrupt.poll(0); });
+    if (request.pitch) applyPitch(*request.pitch, scene, vo);
+    return namedAfter(src, [&] {
+      const bool userBounds = vo.bounds.has_value();
+      vo = vox::withCubicCells(scene, vo);
+      if (!userBounds) {
+        // Without bounds, room around the scene: two cells, and the level's width for a grown surface, on every
+        // side (the same cubic cells), so that the surface is not cut flat at the scene's own bounds.
+        const vox::Grid plan = vox::planGrid(scene, vo);
+        vox::Box b = plan.bounds;
+        std::array<uint32_t, 3> d = plan.dims;
+        for (int a = 0; a < 3; ++a) {
+          const double h = (b.hi[a] - b.lo[a]) / double(d[a]);
+          const double cells = std::ceil(std::max(lvl, 0.0) / h) + 2;
+          if (!(cells < double(vox::kMaxCellsPerAxis))) vox::fail<vox::UsageError>("level ", lvl, " is too large");
+          b.lo.at(a) -= cells * h;
+          b.hi.at(a) += cells * h;
+          d[a] = uint32_t(std::min<double>(d[a] + 2 * cells, vox::kMaxCellsPerAxis));
+        }
+        vo.bounds = b;
+        vo.dims = d;
+        vo.resolution.reset();
+      }
+      vox::checkNumericDomainOfPlan(scene, vo, true, false);
+      vox::Grid g = vox::voxelizeScene(scene, vo);
+      vox::SdfOptions so;
+      so.halfWidth = half ? *half : vox::surfaceHalfWidth(g, lvl);
+      so.memoryLimitBytes = vo.memoryLimitBytes;
+      so.progress = [&](double f) { return interrupt.poll(0.2 + 0.6 * f); };
+      vox::storeSignedDistances(g, scene, so, false);
+      return vox::extractLevelSurface(g, lvl, nullptr, [&](double f) { return interrupt.poll(0.8 + 0.2 * f); });
+    });
+  });
+  for (const std::string& w : src.scene.warnings) warn(src.describe(w));
+  if (!src.scene.planes.empty())
+    warn(src.describe(std::to_string(src.scene.planes.size()) + " planes are left out of the signed distances"));
+  return surfaceArrays(std::move(mesh));
+}
+
 }  // namespace
 
 void bindVoxelize(py::module_& m) {
+  m.def("surface", &surfaceOfSource, py::arg("source"), py::kw_only(), py::arg("resolution") = py::none(),
+        py::arg("dims") = py::none(), py::arg("pitch") = py::none(), py::arg("bounds") = py::none(),
+        py::arg("level") = 0.0, py::arg("half_width") = py::none(), py::arg("threads") = py::none(),
+        py::arg("progress") = false, R"doc(
+A mesh's watertight twin in one call: voxelize(source, ..., sdf=half_width).surface(level) without keeping the grid.
+Returns (vertices (V, 3) float64, faces (F, 3) int64): closed, two-manifold, oriented outward, no zero-area face,
+the level set d = level (world units) of the exact signed distance (negative inside by the winding number, so open,
+self-intersecting and inconsistently oriented meshes come out closed), linearly interpolated between cell centres.
+
+source, resolution, dims, pitch, bounds, threads and progress as for voxelize (with a resolution, cells exactly
+cubic), and without bounds the grid gets two cells (and the level's width) of room on every side, so that the
+surface is not cut at the scene's bounds. half_width: the band in cell widths, in (0, 64]; default the smallest that holds the level (at least 3).
+Raises InputError when |level| exceeds what the band holds (half_width * h - cell diagonal), UsageError for bad
+options, TypeError for wrong types; as voxelize otherwise.
+)doc");
+
   m.def("voxelize", &voxelize, py::arg("source"), py::kw_only(), py::arg("resolution") = py::none(),
         py::arg("dims") = py::none(), py::arg("pitch") = py::none(), py::arg("bounds") = py::none(),
         py::arg("method") = "exact", py::arg("fill") = py::none(), py::arg("sdf") = py::none(),

@@ -8,6 +8,7 @@
 #include "vox/core/error.h"
 #include "vox/core/progress.h"
 #include "vox/core/tool.h"
+#include "vox/export/level_surface.h"
 #include "vox/export/voxel_mesh.h"
 #include "vox/io/atomic_file.h"
 #include "vox/io/grid_file.h"
@@ -20,7 +21,31 @@ using export_tool::namingGrid;
 using export_tool::Options;
 using export_tool::secondsSince;
 
+// --surface: the level set of the grid's distances as a triangle mesh (vox/export/level_surface.h).
+int runSurface(const Options& opt) {
+  const auto start = std::chrono::steady_clock::now();
+  ProgressBar bar("surface", opt.common.quiet);
+  const GridFile file = readGridOrSet(opt.grid);
+  bar.update(0.2);
+  LevelSurfaceStats stats;
+  const VoxelMesh mesh = namingGrid(opt, [&] { return extractLevelSurface(file.grid, *opt.surface, &stats); });
+  bar.update(0.6);
+  const auto writeStart = std::chrono::steady_clock::now();
+  namingGrid(opt, [&] { writeVoxelMesh(opt.output, mesh, !opt.ascii); });
+  const double writeSeconds = secondsSince(writeStart);
+  bar.finish();
+  if (opt.stats)
+    std::fprintf(stderr,
+                 "surface_level: %.17g\nvertices: %zu\nfaces: %zu\ncubes: %zu\ncap_faces: %zu\nbuild_seconds: %.6f\n"
+                 "write_seconds: %.6f\ntotal_seconds: %.6f\n",
+                 *opt.surface, mesh.vertexCount(), mesh.faceCount(), stats.cubes, stats.capTriangles, stats.seconds,
+                 writeSeconds, secondsSince(start));
+  return kExitOk;
+}
+
 int run(const Options& opt) {
+  if (opt.surface && (voxelFormatFromPath(opt.output) || export_tool::isViewerPagePath(opt.output)))
+    throw UsageError("--surface writes a mesh: .ply, .obj, .off, .stl, .glb or .gltf, not " + opt.output);
   if (const auto format = voxelFormatFromPath(opt.output)) return export_tool::runVoxelFormat(opt, *format);
   if (export_tool::isViewerPagePath(opt.output)) return export_tool::runViewerPage(opt);
   const auto start = std::chrono::steady_clock::now();
@@ -35,6 +60,7 @@ int run(const Options& opt) {
   // An OBJ writes its materials to NAME.mtl beside it: that second output must not be the grid either.
   if (meshFormatFromPath(opt.output) == MeshFormat::Obj)
     checkOutputPath(std::filesystem::path(opt.output).replace_extension(".mtl").string(), {opt.grid});
+  if (opt.surface) return runSurface(opt);
   const FaceMode faces = parseFaceMode(opt.faces);
   const ColorMode color = parseColorMode(opt.color);
 

@@ -15,6 +15,7 @@ struct Options {
   std::string color = "count";
   bool ascii = false;
   bool stats = false;
+  std::optional<double> surface;  // --surface [LEVEL]: the level set of the grid's distances instead of the voxels
   cli::CommonOptions common;
 };
 

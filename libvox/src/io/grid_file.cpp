@@ -120,7 +120,7 @@ void putSections(ByteWriter& w, const Scene& scene, const Grid& grid) {
 
 // Sections in strictly increasing tag order, as written (docs/grid-format.md "Sections"): a file has one encoding, and
 // a later section's check may rely on an earlier one's content.
-void getSections(ByteReader& r, Scene& scene, Grid& grid) {
+void getSections(ByteReader& r, Scene& scene, Grid& grid, const SectionContext& context) {
   std::vector<bool> seen(sectionCodecs().size(), false);
   const SectionCodec* previous = nullptr;
   while (!r.atEnd()) {
@@ -140,7 +140,7 @@ void getSections(ByteReader& r, Scene& scene, Grid& grid) {
     seen[c] = true;
     previous = &codec;
     const size_t start = r.position();
-    codec.get(r, scene, grid);
+    codec.get(r, scene, grid, context);
     if (r.position() - start != size) r.corrupt(std::string(codec.name) + " section does not match its size");
   }
 }
@@ -247,13 +247,17 @@ void streamPayload(const Scene& scene, const Grid& grid, const EncodedCellTable&
 
 }  // namespace
 
-uint32_t gridFileVersionFor(const Grid& grid) { return grid.sdfHalfWidth > 0 || !grid.fractions.empty() ? 4 : 3; }
+uint32_t gridFileVersionFor(const Grid& grid) {
+  if (grid.sdfHalfWidth > 0) return 5;
+  return grid.fractions.empty() ? 3 : 4;
+}
 
 std::string encodeGridFile(const Scene& scene, const Grid& grid, uint32_t version,
                            const std::function<bool(double)>& progress) {
   if (version == 0) version = gridFileVersionFor(grid);
   if (version < gridFileVersionFor(grid) && version >= 3)
-    fail<UsageError>("grid file version ", version, " cannot hold distances or volume fractions");
+    fail<UsageError>("grid file version ", version, " cannot hold ",
+                     grid.sdfHalfWidth > 0 ? "this layout of distances" : "volume fractions");
   if (version < 2 || version > kGridFileVersion) fail<UsageError>("cannot write grid file version ", version);
   const EncodedCellTable table = version >= 3 ? encodeCellTable(grid, progress) : EncodedCellTable{};
   const uint64_t cellBytes = version >= 3 ? table.bytes.size() : grid.cellKeys.size() * 16 + grid.primIds.size() * 4;
@@ -372,6 +376,15 @@ void getGridShape(ByteReader& r, Grid& grid) {
   grid.method = OverlapMethod(method);
 }
 
+// Where the version 3 cell table starting at `at` ends, by its byte count (the file's end when that is cut off or
+// past it; getCellTable refuses such a table): only to scale the table's progress.
+size_t cellTableEnd(const std::string& bytes, size_t at) {
+  uint64_t size = 0;
+  if (bytes.size() < at || bytes.size() - at < 24) return bytes.size();
+  std::memcpy(&size, bytes.data() + at + 16, 8);
+  return size > bytes.size() - at - 24 ? bytes.size() : at + 24 + size;
+}
+
 // Structural checks of a version 1 or 2 cell table read at byte `cellsAt` (version 3's decoder checks the same as
 // it reads): sorted unique keys inside the grid, offsets that partition the references, ids below `bounded` (the
 // triangles and spheres).
@@ -411,8 +424,17 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name,
 
   const uint64_t bounded = scene.triangles.size() + scene.spheres.size();
   const size_t cellsAt = r.position();
+  // Progress is the fraction of the file read, so that the cell table and the sections after it (the distance band
+  // is as large) ask in one increasing sequence.
+  const auto fileFraction = [&](size_t position) { return double(position) / double(bytes.size()); };
   if (version >= 3) {
-    getCellTable(r, grid, bounded, progress);
+    const size_t tableEnd = cellTableEnd(bytes, cellsAt);
+    std::function<bool(double)> tableProgress;
+    if (progress)
+      tableProgress = [&](double f) {
+        return progress(fileFraction(cellsAt) + f * (fileFraction(tableEnd) - fileFraction(cellsAt)));
+      };
+    getCellTable(r, grid, bounded, tableProgress);
   } else {
     grid.cellKeys = r.getArray<uint64_t, HugeVector<uint64_t>>("cell");
     grid.cellStart = r.getArray<uint64_t, HugeVector<uint64_t>>("cell start");
@@ -430,8 +452,8 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name,
     const size_t runsAt = r.position();
     grid.solidRuns = r.getArray<CellRun>("solid run");
     checkSolidRuns(grid.solidRuns, cells, name + ": solid runs at byte " + std::to_string(runsAt));
-    getSections(r, scene, grid);
-    if (version < 4 && gridFileVersionFor(grid) == 4)
+    getSections(r, scene, grid, SectionContext{version, progress, bytes.size()});
+    if (version < 4 && gridFileVersionFor(grid) >= 4)
       fail<InputError>(name, ": distances or volume fractions in a version ", version, " file (they need version 4)");
   }
   if (version < 3) checkFlatCellTable(grid, bounded, name, cellsAt);

@@ -13,7 +13,7 @@ bool hasFractionsSection(const Scene&, const Grid& grid) { return !grid.fraction
 
 void putFractionsSection(ByteWriter& w, const Scene&, const Grid& grid) { w.putArray(grid.fractions); }
 
-void getFractionsSection(ByteReader& r, Scene&, Grid& grid) {
+void getFractionsSection(ByteReader& r, Scene&, Grid& grid, const SectionContext&) {
   std::vector<double> fractions = r.getArray<double>("volume fraction");
   if (fractions.size() != grid.occupiedCount())
     r.corrupt(std::to_string(fractions.size()) + " volume fractions for " + std::to_string(grid.occupiedCount()) +

@@ -63,7 +63,7 @@ SolidTexture getSolidTexture(ByteReader& r, size_t materials) {
 
 }  // namespace
 
-void getSolidTexturesSection(ByteReader& r, Scene& scene, Grid&) {
+void getSolidTexturesSection(ByteReader& r, Scene& scene, Grid&, const SectionContext&) {
   const uint64_t n = r.getCount(kTextureBytes, "solid texture");
   if (n == 0) r.corrupt("solid textures section without textures");
   scene.solidTextures.reserve(n);

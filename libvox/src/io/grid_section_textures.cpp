@@ -68,7 +68,7 @@ Texture getTexture(ByteReader& r) {
 
 }  // namespace
 
-void getTexturesSection(ByteReader& r, Scene& scene, Grid&) {
+void getTexturesSection(ByteReader& r, Scene& scene, Grid&, const SectionContext&) {
   const uint64_t nTextures = r.getCount(4 + 4 + 4 + 2 + 8 + 3, "texture");
   if (nTextures == 0) r.corrupt("textures section without textures");
   scene.textures.reserve(nTextures);

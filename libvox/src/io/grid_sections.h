@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 
 #include "io/byte_codec.h"
 #include "vox/core/grid.h"
@@ -20,8 +21,16 @@ enum class SectionTag : uint32_t {
   SolidTextures = 2,
   Brick = 3,
   CameraSpan = 4,
-  Distances = 5,  // grid file version 4
+  Distances = 5,  // grid file version 4 (keys as a flat array) and 5 (keys as runs)
   Fractions = 6,  // grid file version 4
+};
+
+// What a section's reader knows beyond its bytes: the file's version (a section's layout may change with it) and
+// the reader's progress, to be asked with the fraction of the file read at that point (monotone; false cancels).
+struct SectionContext {
+  uint32_t version;
+  std::function<bool(double)> progress;  // empty when nobody asks
+  size_t fileSize;                       // the bytes the fraction is of
 };
 
 struct SectionCodec {
@@ -29,32 +38,33 @@ struct SectionCodec {
   const char* name;  // for error messages
   bool (*has)(const Scene&, const Grid&);
   void (*put)(ByteWriter&, const Scene&, const Grid&);
-  void (*get)(ByteReader&, Scene&, Grid&);
+  void (*get)(ByteReader&, Scene&, Grid&, const SectionContext&);
 };
 
 // Textures (io/grid_section_textures.cpp): image textures, material texture indices, triangle texture coordinates.
 bool hasTexturesSection(const Scene& scene, const Grid& grid);
 void putTexturesSection(ByteWriter& w, const Scene& scene, const Grid& grid);
-void getTexturesSection(ByteReader& r, Scene& scene, Grid& grid);
+void getTexturesSection(ByteReader& r, Scene& scene, Grid& grid, const SectionContext& context);
 
 // SolidTextures (io/grid_section_solid_textures.cpp): the course's Checkerboard, Noise, Marble and Wood materials.
 bool hasSolidTexturesSection(const Scene& scene, const Grid& grid);
 void putSolidTexturesSection(ByteWriter& w, const Scene& scene, const Grid& grid);
-void getSolidTexturesSection(ByteReader& r, Scene& scene, Grid& grid);
+void getSolidTexturesSection(ByteReader& r, Scene& scene, Grid& grid, const SectionContext& context);
 
 // CameraSpan (io/grid_section_camera.cpp): the side of the image a camera's angle or size spans, when not the height.
 bool hasCameraSpanSection(const Scene& scene, const Grid& grid);
 void putCameraSpanSection(ByteWriter& w, const Scene& scene, const Grid& grid);
-void getCameraSpanSection(ByteReader& r, Scene& scene, Grid& grid);
+void getCameraSpanSection(ByteReader& r, Scene& scene, Grid& grid, const SectionContext& context);
 
-// Distances (io/grid_section_distances.cpp): the --sdf band's cell keys and signed distances.
+// Distances (io/grid_section_distances.cpp): the --sdf band's cell keys and signed distances; written in version 5's
+// layout, read in 4's too.
 bool hasDistancesSection(const Scene& scene, const Grid& grid);
 void putDistancesSection(ByteWriter& w, const Scene& scene, const Grid& grid);
-void getDistancesSection(ByteReader& r, Scene& scene, Grid& grid);
+void getDistancesSection(ByteReader& r, Scene& scene, Grid& grid, const SectionContext& context);
 
 // Fractions (io/grid_section_fractions.cpp): --fraction's volume fraction of each occupied cell.
 bool hasFractionsSection(const Scene& scene, const Grid& grid);
 void putFractionsSection(ByteWriter& w, const Scene& scene, const Grid& grid);
-void getFractionsSection(ByteReader& r, Scene& scene, Grid& grid);
+void getFractionsSection(ByteReader& r, Scene& scene, Grid& grid, const SectionContext& context);
 
 }  // namespace vox

@@ -41,7 +41,8 @@ std::string tagged(const std::string& body) {
 // The Distances section (tag, size, body) as this build writes it.
 std::string currentSection(const Scene& scene, const Grid& grid) {
   ByteWriter w;
-  putDistancesSection(w, scene, grid);
+  std::string memo;
+  putDistancesSection(w, scene, grid, memo);
   return tagged(w.bytes());
 }
 
@@ -122,7 +123,9 @@ TEST(GridSectionDistances, RandomBandsRoundTripBitForBitInVersion5AndRereadAsVer
       expectSameBand(decodeGridFile(old, "v4.vgrid").grid, grid);
       // Smaller but for a band of one cell: its 8-byte key becomes a byte count and two 1-byte varints.
       EXPECT_LE(bytes.size(), old.size() + (grid.sdfKeys.size() == 1 ? 2 : 0));
-      if (grid.sdfKeys.size() > 1) EXPECT_LT(bytes.size(), old.size());
+      if (grid.sdfKeys.size() > 1) {
+        EXPECT_LT(bytes.size(), old.size());
+      }
     }
   }
   // Every truncation inside the section is refused, never a crash.

@@ -103,18 +103,23 @@ const std::vector<SectionCodec>& sectionCodecs() {
   return codecs;
 }
 
-void putSections(ByteWriter& w, const Scene& scene, const Grid& grid) {
-  for (const SectionCodec& codec : sectionCodecs()) {
+// `memos`: one per codec, kept by the caller across the passes of one write (SectionCodec::put).
+using SectionMemos = std::vector<std::string>;
+
+void putSections(ByteWriter& w, const Scene& scene, const Grid& grid, SectionMemos& memos) {
+  memos.resize(sectionCodecs().size());
+  for (size_t c = 0; c < sectionCodecs().size(); ++c) {
+    const SectionCodec& codec = sectionCodecs()[c];
     if (!codec.has(scene, grid)) continue;
     // Its size comes before it, and a streaming writer cannot go back: the body is encoded twice, first only to
     // count its bytes (a copy of a section of hundreds of MB, grown by appending, took seconds).
     uint64_t size = 0;
     ByteWriter counter([&](std::string_view bytes) { size += bytes.size(); });
-    codec.put(counter, scene, grid);
+    codec.put(counter, scene, grid, memos[c]);
     counter.finish();
     w.put(uint32_t(codec.tag));
     w.put(size);
-    codec.put(w, scene, grid);
+    codec.put(w, scene, grid, memos[c]);
   }
 }
 
@@ -166,8 +171,8 @@ namespace {
 
 // The payload of docs/grid-format.md (everything after the 32-byte header), in `version` 3 (the cell table in
 // `table`) or 2 (the flat arrays: tests of old files).
-void encodePayload(ByteWriter& w, const Scene& scene, const Grid& grid, const EncodedCellTable& table,
-                   uint32_t version) {
+void encodePayload(ByteWriter& w, const Scene& scene, const Grid& grid, const EncodedCellTable& table, uint32_t version,
+                   SectionMemos& memos) {
   // Scene.
   w.put(uint64_t(scene.materials.size()));
   for (const auto& m : scene.materials) putMaterial(w, m);
@@ -224,7 +229,7 @@ void encodePayload(ByteWriter& w, const Scene& scene, const Grid& grid, const En
   }
   w.putArray(grid.outsidePrims);
   w.putArray(grid.solidRuns);
-  putSections(w, scene, grid);
+  putSections(w, scene, grid, memos);
 }
 
 std::string encodeHeader(uint64_t payloadSize, uint64_t checksum, uint32_t version = kGridFileVersion) {
@@ -239,9 +244,10 @@ std::string encodeHeader(uint64_t payloadSize, uint64_t checksum, uint32_t versi
 }
 
 // Runs the encoder with every byte going to `sink`.
-void streamPayload(const Scene& scene, const Grid& grid, const EncodedCellTable& table, const ByteWriter::Sink& sink) {
+void streamPayload(const Scene& scene, const Grid& grid, const EncodedCellTable& table, SectionMemos& memos,
+                   const ByteWriter::Sink& sink) {
   ByteWriter w(sink);
-  encodePayload(w, scene, grid, table, gridFileVersionFor(grid));
+  encodePayload(w, scene, grid, table, gridFileVersionFor(grid), memos);
   w.finish();
 }
 
@@ -264,7 +270,8 @@ std::string encodeGridFile(const Scene& scene, const Grid& grid, uint32_t versio
   ByteWriter w;
   w.bytes().reserve(kHeaderSize + 256 + scene.triangles.size() * 76 + cellBytes + scene.materials.size() * 128);
   w.bytes().assign(kHeaderSize, '\0');  // the header is filled in last, in place, so the payload is never copied
-  encodePayload(w, scene, grid, table, version);
+  SectionMemos memos;
+  encodePayload(w, scene, grid, table, version, memos);
   std::string bytes = std::move(w.bytes());
   const uint64_t payloadSize = bytes.size() - kHeaderSize;
   const std::string header = encodeHeader(payloadSize, wordChecksum(bytes.data() + kHeaderSize, payloadSize), version);
@@ -479,21 +486,22 @@ void writeGridFile(const std::string& path, const Scene& scene, const Grid& grid
   const EncodedCellTable table = encodeCellTable(grid, [&](double f) { return !progress || progress(0.1 * f); });
   ask(0.1);
   uint64_t size = 0;
-  streamPayload(scene, grid, table, [&](std::string_view bytes) {
+  SectionMemos memos;
+  streamPayload(scene, grid, table, memos, [&](std::string_view bytes) {
     size += bytes.size();
     ask(0.1);
   });
   const double total = double(std::max<uint64_t>(size, 1));
   ChecksumStream sum(size);
   uint64_t done = 0;
-  streamPayload(scene, grid, table, [&](std::string_view bytes) {
+  streamPayload(scene, grid, table, memos, [&](std::string_view bytes) {
     sum.update(bytes);
     ask(0.1 + 0.3 * double(done += bytes.size()) / total);
   });
   OutputFile out(path);
   out.write(encodeHeader(size, sum.value(), gridFileVersionFor(grid)));
   done = 0;
-  streamPayload(scene, grid, table, [&](std::string_view bytes) {
+  streamPayload(scene, grid, table, memos, [&](std::string_view bytes) {
     out.write(bytes);
     ask(0.4 + 0.6 * double(done += bytes.size()) / total);
   });

@@ -11,7 +11,7 @@ namespace vox {
 
 bool hasFractionsSection(const Scene&, const Grid& grid) { return !grid.fractions.empty(); }
 
-void putFractionsSection(ByteWriter& w, const Scene&, const Grid& grid) { w.putArray(grid.fractions); }
+void putFractionsSection(ByteWriter& w, const Scene&, const Grid& grid, std::string&) { w.putArray(grid.fractions); }
 
 void getFractionsSection(ByteReader& r, Scene&, Grid& grid, const SectionContext&) {
   std::vector<double> fractions = r.getArray<double>("volume fraction");

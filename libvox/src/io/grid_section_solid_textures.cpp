@@ -18,7 +18,7 @@ constexpr size_t kTextureBytes = 1 + 16 * 8 + 4 + 4 + 4 + 8 + 8;
 
 bool hasSolidTexturesSection(const Scene& scene, const Grid&) { return !scene.solidTextures.empty(); }
 
-void putSolidTexturesSection(ByteWriter& w, const Scene& scene, const Grid&) {
+void putSolidTexturesSection(ByteWriter& w, const Scene& scene, const Grid&, std::string&) {
   w.put(uint64_t(scene.solidTextures.size()));
   for (const SolidTexture& t : scene.solidTextures) {
     w.put(uint8_t(t.kind));

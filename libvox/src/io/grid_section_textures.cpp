@@ -15,7 +15,7 @@ namespace vox {
 
 bool hasTexturesSection(const Scene& scene, const Grid&) { return !scene.textures.empty(); }
 
-void putTexturesSection(ByteWriter& w, const Scene& scene, const Grid&) {
+void putTexturesSection(ByteWriter& w, const Scene& scene, const Grid&, std::string&) {
   w.put(uint64_t(scene.textures.size()));
   for (const Texture& t : scene.textures) {
     w.putString(t.name);

@@ -130,6 +130,7 @@ class ByteReader {
     return bytes;
   }
   size_t position() const { return pos_; }
+  size_t remaining() const { return data_.size() - pos_; }
   const std::string& name() const { return name_; }
   bool atEnd() const { return pos_ == data_.size(); }
 

@@ -103,24 +103,29 @@ const std::vector<SectionCodec>& sectionCodecs() {
   return codecs;
 }
 
-void putSections(ByteWriter& w, const Scene& scene, const Grid& grid) {
-  for (const SectionCodec& codec : sectionCodecs()) {
+// `memos`: one per codec, kept by the caller across the passes of one write (SectionCodec::put).
+using SectionMemos = std::vector<std::string>;
+
+void putSections(ByteWriter& w, const Scene& scene, const Grid& grid, SectionMemos& memos) {
+  memos.resize(sectionCodecs().size());
+  for (size_t c = 0; c < sectionCodecs().size(); ++c) {
+    const SectionCodec& codec = sectionCodecs()[c];
     if (!codec.has(scene, grid)) continue;
     // Its size comes before it, and a streaming writer cannot go back: the body is encoded twice, first only to
     // count its bytes (a copy of a section of hundreds of MB, grown by appending, took seconds).
     uint64_t size = 0;
     ByteWriter counter([&](std::string_view bytes) { size += bytes.size(); });
-    codec.put(counter, scene, grid);
+    codec.put(counter, scene, grid, memos[c]);
     counter.finish();
     w.put(uint32_t(codec.tag));
     w.put(size);
-    codec.put(w, scene, grid);
+    codec.put(w, scene, grid, memos[c]);
   }
 }
 
 // Sections in strictly increasing tag order, as written (docs/grid-format.md "Sections"): a file has one encoding, and
 // a later section's check may rely on an earlier one's content.
-void getSections(ByteReader& r, Scene& scene, Grid& grid) {
+void getSections(ByteReader& r, Scene& scene, Grid& grid, const SectionContext& context) {
   std::vector<bool> seen(sectionCodecs().size(), false);
   const SectionCodec* previous = nullptr;
   while (!r.atEnd()) {
@@ -140,7 +145,7 @@ void getSections(ByteReader& r, Scene& scene, Grid& grid) {
     seen[c] = true;
     previous = &codec;
     const size_t start = r.position();
-    codec.get(r, scene, grid);
+    codec.get(r, scene, grid, context);
     if (r.position() - start != size) r.corrupt(std::string(codec.name) + " section does not match its size");
   }
 }
@@ -166,8 +171,8 @@ namespace {
 
 // The payload of docs/grid-format.md (everything after the 32-byte header), in `version` 3 (the cell table in
 // `table`) or 2 (the flat arrays: tests of old files).
-void encodePayload(ByteWriter& w, const Scene& scene, const Grid& grid, const EncodedCellTable& table,
-                   uint32_t version) {
+void encodePayload(ByteWriter& w, const Scene& scene, const Grid& grid, const EncodedCellTable& table, uint32_t version,
+                   SectionMemos& memos) {
   // Scene.
   w.put(uint64_t(scene.materials.size()));
   for (const auto& m : scene.materials) putMaterial(w, m);
@@ -224,7 +229,7 @@ void encodePayload(ByteWriter& w, const Scene& scene, const Grid& grid, const En
   }
   w.putArray(grid.outsidePrims);
   w.putArray(grid.solidRuns);
-  putSections(w, scene, grid);
+  putSections(w, scene, grid, memos);
 }
 
 std::string encodeHeader(uint64_t payloadSize, uint64_t checksum, uint32_t version = kGridFileVersion) {
@@ -239,28 +244,34 @@ std::string encodeHeader(uint64_t payloadSize, uint64_t checksum, uint32_t versi
 }
 
 // Runs the encoder with every byte going to `sink`.
-void streamPayload(const Scene& scene, const Grid& grid, const EncodedCellTable& table, const ByteWriter::Sink& sink) {
+void streamPayload(const Scene& scene, const Grid& grid, const EncodedCellTable& table, SectionMemos& memos,
+                   const ByteWriter::Sink& sink) {
   ByteWriter w(sink);
-  encodePayload(w, scene, grid, table, gridFileVersionFor(grid));
+  encodePayload(w, scene, grid, table, gridFileVersionFor(grid), memos);
   w.finish();
 }
 
 }  // namespace
 
-uint32_t gridFileVersionFor(const Grid& grid) { return grid.sdfHalfWidth > 0 || !grid.fractions.empty() ? 4 : 3; }
+uint32_t gridFileVersionFor(const Grid& grid) {
+  if (grid.sdfHalfWidth > 0) return 5;
+  return grid.fractions.empty() ? 3 : 4;
+}
 
 std::string encodeGridFile(const Scene& scene, const Grid& grid, uint32_t version,
                            const std::function<bool(double)>& progress) {
   if (version == 0) version = gridFileVersionFor(grid);
   if (version < gridFileVersionFor(grid) && version >= 3)
-    fail<UsageError>("grid file version ", version, " cannot hold distances or volume fractions");
+    fail<UsageError>("grid file version ", version, " cannot hold ",
+                     grid.sdfHalfWidth > 0 ? "this layout of distances" : "volume fractions");
   if (version < 2 || version > kGridFileVersion) fail<UsageError>("cannot write grid file version ", version);
   const EncodedCellTable table = version >= 3 ? encodeCellTable(grid, progress) : EncodedCellTable{};
   const uint64_t cellBytes = version >= 3 ? table.bytes.size() : grid.cellKeys.size() * 16 + grid.primIds.size() * 4;
   ByteWriter w;
   w.bytes().reserve(kHeaderSize + 256 + scene.triangles.size() * 76 + cellBytes + scene.materials.size() * 128);
   w.bytes().assign(kHeaderSize, '\0');  // the header is filled in last, in place, so the payload is never copied
-  encodePayload(w, scene, grid, table, version);
+  SectionMemos memos;
+  encodePayload(w, scene, grid, table, version, memos);
   std::string bytes = std::move(w.bytes());
   const uint64_t payloadSize = bytes.size() - kHeaderSize;
   const std::string header = encodeHeader(payloadSize, wordChecksum(bytes.data() + kHeaderSize, payloadSize), version);
@@ -372,6 +383,15 @@ void getGridShape(ByteReader& r, Grid& grid) {
   grid.method = OverlapMethod(method);
 }
 
+// Where the version 3 cell table starting at `at` ends, by its byte count (the file's end when that is cut off or
+// past it; getCellTable refuses such a table): only to scale the table's progress.
+size_t cellTableEnd(const std::string& bytes, size_t at) {
+  uint64_t size = 0;
+  if (bytes.size() < at || bytes.size() - at < 24) return bytes.size();
+  std::memcpy(&size, bytes.data() + at + 16, 8);
+  return size > bytes.size() - at - 24 ? bytes.size() : at + 24 + size;
+}
+
 // Structural checks of a version 1 or 2 cell table read at byte `cellsAt` (version 3's decoder checks the same as
 // it reads): sorted unique keys inside the grid, offsets that partition the references, ids below `bounded` (the
 // triangles and spheres).
@@ -411,8 +431,17 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name,
 
   const uint64_t bounded = scene.triangles.size() + scene.spheres.size();
   const size_t cellsAt = r.position();
+  // Progress is the fraction of the file read, so that the cell table and the sections after it (the distance band
+  // is as large) ask in one increasing sequence.
+  const auto fileFraction = [&](size_t position) { return double(position) / double(bytes.size()); };
   if (version >= 3) {
-    getCellTable(r, grid, bounded, progress);
+    const size_t tableEnd = cellTableEnd(bytes, cellsAt);
+    std::function<bool(double)> tableProgress;
+    if (progress)
+      tableProgress = [&](double f) {
+        return progress(fileFraction(cellsAt) + f * (fileFraction(tableEnd) - fileFraction(cellsAt)));
+      };
+    getCellTable(r, grid, bounded, tableProgress);
   } else {
     grid.cellKeys = r.getArray<uint64_t, HugeVector<uint64_t>>("cell");
     grid.cellStart = r.getArray<uint64_t, HugeVector<uint64_t>>("cell start");
@@ -430,8 +459,8 @@ GridFile decodeGridFile(const std::string& bytes, const std::string& name,
     const size_t runsAt = r.position();
     grid.solidRuns = r.getArray<CellRun>("solid run");
     checkSolidRuns(grid.solidRuns, cells, name + ": solid runs at byte " + std::to_string(runsAt));
-    getSections(r, scene, grid);
-    if (version < 4 && gridFileVersionFor(grid) == 4)
+    getSections(r, scene, grid, SectionContext{version, progress, bytes.size()});
+    if (version < 4 && gridFileVersionFor(grid) >= 4)
       fail<InputError>(name, ": distances or volume fractions in a version ", version, " file (they need version 4)");
   }
   if (version < 3) checkFlatCellTable(grid, bounded, name, cellsAt);
@@ -457,21 +486,22 @@ void writeGridFile(const std::string& path, const Scene& scene, const Grid& grid
   const EncodedCellTable table = encodeCellTable(grid, [&](double f) { return !progress || progress(0.1 * f); });
   ask(0.1);
   uint64_t size = 0;
-  streamPayload(scene, grid, table, [&](std::string_view bytes) {
+  SectionMemos memos;
+  streamPayload(scene, grid, table, memos, [&](std::string_view bytes) {
     size += bytes.size();
     ask(0.1);
   });
   const double total = double(std::max<uint64_t>(size, 1));
   ChecksumStream sum(size);
   uint64_t done = 0;
-  streamPayload(scene, grid, table, [&](std::string_view bytes) {
+  streamPayload(scene, grid, table, memos, [&](std::string_view bytes) {
     sum.update(bytes);
     ask(0.1 + 0.3 * double(done += bytes.size()) / total);
   });
   OutputFile out(path);
   out.write(encodeHeader(size, sum.value(), gridFileVersionFor(grid)));
   done = 0;
-  streamPayload(scene, grid, table, [&](std::string_view bytes) {
+  streamPayload(scene, grid, table, memos, [&](std::string_view bytes) {
     out.write(bytes);
     ask(0.4 + 0.6 * double(done += bytes.size()) / total);
   });

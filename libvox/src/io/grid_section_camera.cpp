@@ -14,9 +14,11 @@ bool hasCameraSpanSection(const Scene& scene, const Grid&) {
   return scene.camera && scene.camera->span != CameraSpan::Height;
 }
 
-void putCameraSpanSection(ByteWriter& w, const Scene& scene, const Grid&) { w.put(uint8_t(scene.camera->span)); }
+void putCameraSpanSection(ByteWriter& w, const Scene& scene, const Grid&, std::string&) {
+  w.put(uint8_t(scene.camera->span));
+}
 
-void getCameraSpanSection(ByteReader& r, Scene& scene, Grid&) {
+void getCameraSpanSection(ByteReader& r, Scene& scene, Grid&, const SectionContext&) {
   const uint8_t span = r.get<uint8_t>();
   if (!scene.camera) r.corrupt("camera span section without a camera");
   if (span != uint8_t(CameraSpan::LongerSide)) r.corrupt("unknown camera span " + std::to_string(span));

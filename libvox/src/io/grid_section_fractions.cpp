@@ -11,9 +11,9 @@ namespace vox {
 
 bool hasFractionsSection(const Scene&, const Grid& grid) { return !grid.fractions.empty(); }
 
-void putFractionsSection(ByteWriter& w, const Scene&, const Grid& grid) { w.putArray(grid.fractions); }
+void putFractionsSection(ByteWriter& w, const Scene&, const Grid& grid, std::string&) { w.putArray(grid.fractions); }
 
-void getFractionsSection(ByteReader& r, Scene&, Grid& grid) {
+void getFractionsSection(ByteReader& r, Scene&, Grid& grid, const SectionContext&) {
   std::vector<double> fractions = r.getArray<double>("volume fraction");
   if (fractions.size() != grid.occupiedCount())
     r.corrupt(std::to_string(fractions.size()) + " volume fractions for " + std::to_string(grid.occupiedCount()) +

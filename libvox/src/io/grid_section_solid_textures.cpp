@@ -18,7 +18,7 @@ constexpr size_t kTextureBytes = 1 + 16 * 8 + 4 + 4 + 4 + 8 + 8;
 
 bool hasSolidTexturesSection(const Scene& scene, const Grid&) { return !scene.solidTextures.empty(); }
 
-void putSolidTexturesSection(ByteWriter& w, const Scene& scene, const Grid&) {
+void putSolidTexturesSection(ByteWriter& w, const Scene& scene, const Grid&, std::string&) {
   w.put(uint64_t(scene.solidTextures.size()));
   for (const SolidTexture& t : scene.solidTextures) {
     w.put(uint8_t(t.kind));
@@ -63,7 +63,7 @@ SolidTexture getSolidTexture(ByteReader& r, size_t materials) {
 
 }  // namespace
 
-void getSolidTexturesSection(ByteReader& r, Scene& scene, Grid&) {
+void getSolidTexturesSection(ByteReader& r, Scene& scene, Grid&, const SectionContext&) {
   const uint64_t n = r.getCount(kTextureBytes, "solid texture");
   if (n == 0) r.corrupt("solid textures section without textures");
   scene.solidTextures.reserve(n);

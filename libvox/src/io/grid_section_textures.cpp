@@ -15,7 +15,7 @@ namespace vox {
 
 bool hasTexturesSection(const Scene& scene, const Grid&) { return !scene.textures.empty(); }
 
-void putTexturesSection(ByteWriter& w, const Scene& scene, const Grid&) {
+void putTexturesSection(ByteWriter& w, const Scene& scene, const Grid&, std::string&) {
   w.put(uint64_t(scene.textures.size()));
   for (const Texture& t : scene.textures) {
     w.putString(t.name);
@@ -68,7 +68,7 @@ Texture getTexture(ByteReader& r) {
 
 }  // namespace
 
-void getTexturesSection(ByteReader& r, Scene& scene, Grid&) {
+void getTexturesSection(ByteReader& r, Scene& scene, Grid&, const SectionContext&) {
   const uint64_t nTextures = r.getCount(4 + 4 + 4 + 2 + 8 + 3, "texture");
   if (nTextures == 0) r.corrupt("textures section without textures");
   scene.textures.reserve(nTextures);

@@ -6,7 +6,7 @@
 #include <limits>
 #include <numeric>
 
-#include <tbb/parallel_for.h>
+#include <emmintrin.h>
 
 namespace vox {
 
@@ -14,31 +14,42 @@ namespace {
 
 constexpr uint32_t kLeafSize = 4;
 
+// The float bounds' rounding allowance, per unit of |q|_1 plus the box's or triangle's own magnitude (about the
+// origin): a float conversion errs by 2^-24 of its value, and each bound is a few float operations on values that
+// are no larger, so the float bound errs from the same bound in real arithmetic by at most 9 * 2^-24 of that size
+// (sums, products and the conversions of q, the normals and the offsets). 2^-18 is more than four times that, so
+// the allowance also covers the double route's own rounding (about 2^-50 of the same size: the exact distance
+// computed relative to p, the double lower bound) with room to spare: a bound lowered by it is at most the double
+// bound it stands for, and below the computed exact distance of every primitive it bounds. kAbsolute covers the
+// values that underflow to subnormal floats (a scene far smaller than its distance from the origin).
+constexpr float kRelative = 0x1p-18f;
+constexpr float kAbsolute = 0x1p-100f;
+// Points farther than this from the origin (in the frame, where the scene's magnitude is in [1, 2)) are searched
+// without float pruning: their squares would leave the float range.
+constexpr double kFloatReach = 0x1p60;
+
 Box unite(const Box& a, const Box& b) { return {minVec(a.lo, b.lo), maxVec(a.hi, b.hi)}; }
 
-// A lower bound of the squared distance from p to anything inside the box: the box's own distance, less a rounding
-// allowance (the axes are orthonormal only to rounding, and the projections round relative to |p - centre|).
-double squaredDistanceToOrientedBox(const NearestPrimitive::OrientedBox& b, const Vec3& p) {
-  const Vec3 d = p - b.centre;
-  const double err = 1e-13 * (std::fabs(d.x) + std::fabs(d.y) + std::fabs(d.z));
-  double sum = 0;
-  for (int a = 0; a < 3; ++a) {
-    const double outside = std::fabs(dot(b.axes[a], d)) - b.half[a] - err;
-    const double e = outside > 0 ? outside : 0.0;  // a maxsd, where std::max's NaN rules make a branch
-    sum += e * e;
-  }
-  return sum * (1 - 1e-12);
+// The float at most x (at least x), one float step further out: the double x may itself have been rounded, by far
+// less than a float step.
+float floatBelow(double x) {
+  float f = float(x);
+  if (double(f) > x) f = std::nextafter(f, -INFINITY);
+  return std::nextafter(f, -INFINITY);
+}
+float floatAbove(double x) { return -floatBelow(-x); }
+
+// The squared distance below which a bound must lie for the search to open what it bounds, as a float rounded up:
+// a float bound above it exceeds best2 (1 + 2^-21) in real arithmetic, after the float squares' and sums' own
+// rounding (2^-22 relative, 2^-148 absolute), so the double route would have pruned it too.
+float pruneAbove(double best2) {
+  const double b = best2 * (1 + 0x1p-20) + 0x1p-126;
+  return b < double(std::numeric_limits<float>::max()) ? floatAbove(b) : INFINITY;
 }
 
-// The points whose convex hull holds primitive `id`: a triangle's corners, the corners of a sphere's box.
-template <typename Visit>
-void forHullPoints(const Scene& scene, const std::vector<Box>& boxes, uint32_t id, const Visit& visit) {
-  if (id < scene.triangles.size()) {
-    for (const Vec3& v : scene.triangles[id].v) visit(v);
-    return;
-  }
-  const Box& b = boxes[id];
-  for (int c = 0; c < 8; ++c) visit(Vec3{c & 1 ? b.hi.x : b.lo.x, c & 2 ? b.hi.y : b.lo.y, c & 4 ? b.hi.z : b.lo.z});
+double surfaceArea(const Box& b) {
+  const Vec3 e = b.hi - b.lo;
+  return e.x * e.y + e.y * e.z + e.z * e.x;
 }
 
 }  // namespace
@@ -59,21 +70,14 @@ NearestPrimitive::NearestPrimitive(const Scene& scene) : triangleCount_(uint32_t
   }
   ids_.resize(n);
   std::iota(ids_.begin(), ids_.end(), 0u);
-  if (n > 0) {
-    nodes_.reserve(2 * (n / kLeafSize + 1));
-    std::vector<std::array<uint32_t, 2>> ranges;  // each node's slots
-    build(0, uint32_t(n), centroids, ranges, 0);
-    // Each box depends only on its node's slots: all of them at once.
-    tbb::parallel_for(size_t(0), nodes_.size(),
-                      [&](size_t i) { nodes_[i].box = orientedBounds(ranges[i][0], ranges[i][1], scene, boxes); });
-  }
-  // Triangles copied in leaf order, so a leaf's are adjacent in memory.
   triangles_.resize(n);
   bounds_.resize(n);
   slotOf_.resize(n);
-  leafOf_.resize(n);
-  for (uint32_t i = 0; i < nodes_.size(); ++i)
-    for (uint32_t s = nodes_[i].first; s < nodes_[i].first + nodes_[i].count; ++s) leafOf_[s] = i;
+  if (n == 0) return;
+  std::vector<BinaryNode> nodes;
+  nodes.reserve(2 * (n / kLeafSize + 1));
+  build(0, uint32_t(n), centroids, nodes);
+  // Triangles copied in leaf order, so a leaf's are adjacent in memory.
   for (size_t s = 0; s < n; ++s) slotOf_[ids_[s]] = uint32_t(s);
   for (size_t s = 0; s < n; ++s)
     if (ids_[s] < triangleCount_) {
@@ -81,70 +85,118 @@ NearestPrimitive::NearestPrimitive(const Scene& scene) : triangleCount_(uint32_t
       triangles_[s] = t;
       bounds_[s] = triangleLowerBound(t);
     }
+  // Each node's box, children after their parent in `nodes`: from the last node back.
+  std::vector<Box> nodeBoxes(nodes.size());
+  for (size_t i = nodes.size(); i-- > 0;) {
+    const BinaryNode& node = nodes[i];
+    if (node.count == 0) {
+      nodeBoxes[i] = unite(nodeBoxes[i + 1], nodeBoxes[node.first]);
+      continue;
+    }
+    nodeBoxes[i] = boxes[ids_[node.first]];
+    for (uint32_t s = node.first + 1; s < node.first + node.count; ++s)
+      nodeBoxes[i] = unite(nodeBoxes[i], boxes[ids_[s]]);
+  }
+  origin_ = (nodeBoxes[0].lo + nodeBoxes[0].hi) * 0.5;
+  wide_.reserve(nodes.size() / 3 + 1);
+  leaves_.reserve(nodes.size() / 2 + 1);
+  buildWide(0, nodes, nodeBoxes);
 }
 
-// The oriented box of the primitives in slots [begin, end): the principal axes of their hull points (a tight slab
-// around a flat patch, where an axis-aligned box leaves a wide margin), its extents taken about the final centre and
-// widened for the projections' rounding, so that every point of every primitive lies inside.
-NearestPrimitive::OrientedBox NearestPrimitive::orientedBounds(uint32_t begin, uint32_t end, const Scene& scene,
-                                                               const std::vector<Box>& boxes) const {
-  Vec3 sum{0, 0, 0};
-  double count = 0;
-  for (uint32_t s = begin; s < end; ++s)
-    forHullPoints(scene, boxes, ids_[s], [&](const Vec3& q) { sum = sum + q, ++count; });
-  const Vec3 mean = sum / count;
-  std::array<std::array<double, 3>, 3> covariance{};
-  for (uint32_t s = begin; s < end; ++s)
-    forHullPoints(scene, boxes, ids_[s], [&](const Vec3& q) {
-      const Vec3 d = q - mean;
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) covariance[i][j] += d[i] * d[j];
-    });
-  OrientedBox box;
-  box.axes = symmetricEigenvectors(covariance);
-  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi = lo * -1.0;
-  for (uint32_t s = begin; s < end; ++s)
-    forHullPoints(scene, boxes, ids_[s], [&](const Vec3& q) {
-      for (int a = 0; a < 3; ++a) {
-        const double u = dot(box.axes[a], q - mean);
-        lo.at(a) = std::min(lo[a], u), hi.at(a) = std::max(hi[a], u);
-      }
-    });
-  box.centre = mean;
-  for (int a = 0; a < 3; ++a) box.centre = box.centre + box.axes[a] * (0.5 * (lo[a] + hi[a]));
-  box.half = {0, 0, 0};
-  for (uint32_t s = begin; s < end; ++s)
-    forHullPoints(scene, boxes, ids_[s], [&](const Vec3& q) {
-      for (int a = 0; a < 3; ++a) box.half.at(a) = std::max(box.half[a], std::fabs(dot(box.axes[a], q - box.centre)));
-    });
-  const double widen = 1e-12 * (box.half.x + box.half.y + box.half.z);
-  for (int a = 0; a < 3; ++a) box.half.at(a) = box.half[a] * (1 + 1e-12) + widen;
-  return box;
-}
-
-// Median split of the centroids on the longest axis of their spread: balanced, and built in O(n log n).
+// Median split of the centroids on the longest axis of their spread: balanced (depth at most 31 for 2^32
+// primitives), and built in O(n log n).
 uint32_t NearestPrimitive::build(uint32_t begin, uint32_t end, const std::vector<Vec3>& centroids,
-                                 std::vector<std::array<uint32_t, 2>>& ranges, uint32_t parent) {
-  const uint32_t index = uint32_t(nodes_.size());
-  nodes_.push_back({});
-  ranges.push_back({begin, end});
-  nodes_[index].parent = parent;
-  Box spread{centroids[ids_[begin]], centroids[ids_[begin]]};
-  for (uint32_t s = begin + 1; s < end; ++s) spread = unite(spread, {centroids[ids_[s]], centroids[ids_[s]]});
+                                 std::vector<BinaryNode>& nodes) {
+  const uint32_t index = uint32_t(nodes.size());
+  nodes.push_back({});
   if (end - begin <= kLeafSize) {
-    nodes_[index].first = begin;
-    nodes_[index].count = end - begin;
+    nodes[index] = {begin, end - begin};
     return index;
   }
+  Box spread{centroids[ids_[begin]], centroids[ids_[begin]]};
+  for (uint32_t s = begin + 1; s < end; ++s) spread = unite(spread, {centroids[ids_[s]], centroids[ids_[s]]});
   const Vec3 extent = spread.hi - spread.lo;
   const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
   const uint32_t mid = begin + (end - begin) / 2;
   std::nth_element(ids_.begin() + begin, ids_.begin() + mid, ids_.begin() + end, [&](uint32_t a, uint32_t b) {
     return centroids[a][axis] != centroids[b][axis] ? centroids[a][axis] < centroids[b][axis] : a < b;
   });
-  build(begin, mid, centroids, ranges, index);
-  nodes_[index].first = build(mid, end, centroids, ranges, index);
+  build(begin, mid, centroids, nodes);
+  nodes[index].first = build(mid, end, centroids, nodes);
   return index;
+}
+
+// The four-wide node over binary node `index`: its children, the one of largest surface area replaced by its two
+// until there are four (or only leaves), each child's box converted outward to float about origin_.
+int32_t NearestPrimitive::buildWide(uint32_t index, const std::vector<BinaryNode>& nodes,
+                                    const std::vector<Box>& nodeBoxes) {
+  std::vector<uint32_t> children{index};
+  for (;;) {
+    int widest = -1;
+    for (size_t c = 0; c < children.size(); ++c)
+      if (nodes[children[c]].count == 0 &&
+          (widest < 0 || surfaceArea(nodeBoxes[children[c]]) > surfaceArea(nodeBoxes[children[size_t(widest)]])))
+        widest = int(c);
+    if (widest < 0 || (children.size() > 1 && children.size() + 1 > 4)) break;
+    const uint32_t inner = children[size_t(widest)];
+    children[size_t(widest)] = inner + 1;
+    children.insert(children.begin() + widest + 1, nodes[inner].first);
+  }
+  const int32_t self = int32_t(wide_.size());
+  wide_.emplace_back();
+  WideNode node;
+  node.count = uint32_t(children.size());
+  for (int lane = 0; lane < 4; ++lane) {
+    node.child[lane] = 0;
+    node.magnitude[lane] = 0;
+    for (int a = 0; a < 3; ++a) node.lo[a][lane] = node.hi[a][lane] = 0;
+  }
+  for (size_t lane = 0; lane < children.size(); ++lane) {
+    const Box& b = nodeBoxes[children[lane]];
+    float magnitude = 0;
+    for (int a = 0; a < 3; ++a) {
+      node.lo[a][lane] = floatBelow(b.lo[a] - origin_[a]);
+      node.hi[a][lane] = floatAbove(b.hi[a] - origin_[a]);
+      magnitude += std::max(std::fabs(node.lo[a][lane]), std::fabs(node.hi[a][lane]));
+    }
+    node.magnitude[lane] = magnitude * (1 + 0x1p-20f);
+    const BinaryNode& child = nodes[children[lane]];
+    if (child.count > 0) {
+      leaves_.push_back(makeLeaf(child));
+      node.child[lane] = ~int32_t(leaves_.size() - 1);
+    } else {
+      node.child[lane] = buildWide(children[lane], nodes, nodeBoxes);
+    }
+  }
+  wide_[size_t(self)] = node;
+  return self;
+}
+
+// A leaf's float rows (WideLeaf). Each triangle's allowance: the double bound's own (slack |p - a|_1 + slackAt0,
+// with |p - a|_1 at most |q|_1 + |a - origin|_1) plus kRelative of the magnitudes the float rows are computed from.
+NearestPrimitive::WideLeaf NearestPrimitive::makeLeaf(const BinaryNode& node) const {
+  WideLeaf leaf{};
+  leaf.first = node.first;
+  leaf.count = node.count;
+  const auto l1 = [](const Vec3& v) { return std::fabs(v.x) + std::fabs(v.y) + std::fabs(v.z); };
+  for (uint32_t lane = 0; lane < node.count; ++lane) {
+    const uint32_t slot = node.first + lane;
+    if (ids_[slot] >= triangleCount_ || !bounds_[slot].usable) continue;  // zero rows: never pruned
+    const Triangle& t = triangles_[slot];
+    const TriangleLowerBound& b = bounds_[slot];
+    double magnitude = 0;
+    for (const Vec3& v : t.v) magnitude = std::max(magnitude, l1(v - origin_));
+    for (int a = 0; a < 3; ++a) leaf.n[a][lane] = float(b.normal[a]);
+    leaf.w[lane] = float(dot(b.normal, t.v[0] - origin_));
+    for (int e = 0; e < 3; ++e) {
+      for (int a = 0; a < 3; ++a) leaf.e[e][a][lane] = float(b.edgeNormals[e][a]);
+      leaf.ew[e][lane] = float(dot(b.edgeNormals[e], t.v[e] - origin_));
+    }
+    const double k1 = b.slack + double(kRelative);
+    leaf.k1[lane] = floatAbove(k1);
+    leaf.k0[lane] = floatAbove(b.slackAt0 + k1 * magnitude * (1 + 0x1p-20) + double(kAbsolute));
+  }
+  return leaf;
 }
 
 // The squared distance from p to the primitive in `slot`, or infinity when a triangle's plane alone is farther
@@ -156,34 +208,47 @@ double NearestPrimitive::squaredDistanceTo(uint32_t slot, const Vec3& p, double 
   return dot(d, d);
 }
 
-// From the seed's leaf up: at each ancestor, the subtree on the other side is searched (most are pruned by their
-// box alone). Near answers lie in near subtrees, so this tests fewer boxes than a descent from the root.
+// The seed's exact distance is the first bound, tight when the seed is the answer or nearly so, so that the search
+// from the root opens few nodes. Ties still go to the lowest id: the seed's equals are visited and win by id.
 NearestHit NearestPrimitive::nearestFrom(const Vec3& p, int64_t seed) const {
   if (seed < 0 || uint64_t(seed) >= ids_.size()) return nearest(p);
-  // The seed's leaf first, the seed among its primitives: its distance becomes the bound.
   NearestHit best;
-  uint32_t node = leafOf_[slotOf_[size_t(seed)]];
-  visitLeaf(nodes_[node], p, best);
-  while (node != 0) {
-    const uint32_t parent = nodes_[node].parent;
-    search(p, best, node == parent + 1 ? nodes_[parent].first : parent + 1);
-    node = parent;
-  }
+  best.squaredDistance = squaredDistanceTo(slotOf_[size_t(seed)], p, INFINITY);
+  best.primitive = seed;
+  search(p, best);
   return best;
 }
 
 NearestHit NearestPrimitive::nearest(const Vec3& p, double bound2) const {
   NearestHit best;
   best.squaredDistance = bound2;
-  if (!nodes_.empty()) search(p, best, 0);
+  search(p, best);
   if (best.primitive < 0) best.squaredDistance = INFINITY;
   return best;
 }
 
-void NearestPrimitive::visitLeaf(const Node& leaf, const Vec3& p, NearestHit& best) const {
-  for (uint32_t s = leaf.first; s < leaf.first + leaf.count; ++s) {
-    const double d2 = squaredDistanceTo(s, p, best.squaredDistance);
-    const int64_t id = ids_[s];
+// The leaf's triangles' float lower bounds, four at once; the survivors, in slot order, get the double route (which
+// may still prune with the best as it is by then) as the binary double search gave them.
+void NearestPrimitive::visitLeaf(const WideLeaf& leaf, const Vec3& p, const float (&q)[3], float qNorm, float bestUp,
+                                 NearestHit& best) const {
+  const __m128 qx = _mm_set1_ps(q[0]), qy = _mm_set1_ps(q[1]), qz = _mm_set1_ps(q[2]), zero = _mm_setzero_ps();
+  const auto row = [&](const float(&v)[3][4], const float* w) {
+    const __m128 d = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_load_ps(v[0]), qx), _mm_mul_ps(_mm_load_ps(v[1]), qy)),
+                                _mm_mul_ps(_mm_load_ps(v[2]), qz));
+    return _mm_sub_ps(d, _mm_load_ps(w));
+  };
+  const __m128 plane = row(leaf.n, leaf.w);
+  const __m128 h = _mm_max_ps(plane, _mm_sub_ps(zero, plane));
+  const __m128 s =
+      _mm_max_ps(_mm_max_ps(row(leaf.e[0], leaf.ew[0]), row(leaf.e[1], leaf.ew[1])), row(leaf.e[2], leaf.ew[2]));
+  const __m128 allowance = _mm_add_ps(_mm_mul_ps(_mm_load_ps(leaf.k1), _mm_set1_ps(qNorm)), _mm_load_ps(leaf.k0));
+  const __m128 hl = _mm_max_ps(_mm_sub_ps(h, allowance), zero), sl = _mm_max_ps(_mm_sub_ps(s, allowance), zero);
+  const __m128 lb2 = _mm_add_ps(_mm_mul_ps(hl, hl), _mm_mul_ps(sl, sl));
+  unsigned open = unsigned(_mm_movemask_ps(_mm_cmple_ps(lb2, _mm_set1_ps(bestUp)))) & ((1u << leaf.count) - 1);
+  for (; open != 0; open &= open - 1) {
+    const uint32_t slot = leaf.first + uint32_t(__builtin_ctz(open));
+    const double d2 = squaredDistanceTo(slot, p, best.squaredDistance);
+    const int64_t id = ids_[slot];
     if (d2 < best.squaredDistance || (d2 == best.squaredDistance && (best.primitive < 0 || id < best.primitive))) {
       best.squaredDistance = d2;
       best.primitive = id;
@@ -191,38 +256,68 @@ void NearestPrimitive::visitLeaf(const Node& leaf, const Vec3& p, NearestHit& be
   }
 }
 
-// Lowers `best` to the nearest primitive of the subtree at `root` within it (ties to the lowest id): every subtree
-// whose box is no farther than the best so far is visited, nearer child first.
-void NearestPrimitive::search(const Vec3& p, NearestHit& best, uint32_t root) const {
-  // Depth is about log2(n / kLeafSize) + 1 for a median split: 64 holds any 32-bit count. Each waiting subtree
-  // keeps its box's squared distance, so that it is tested again without recomputing it.
+// Lowers `best` to the nearest primitive within it (ties to the lowest id): every child whose float box bound is
+// no farther than the best so far (pruneAbove) is visited, nearer children first.
+void NearestPrimitive::search(const Vec3& p, NearestHit& best) const {
+  if (wide_.empty()) return;
+  const Vec3 d = p - origin_;
+  const bool prune = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)}) <= kFloatReach;
+  float q[3] = {0, 0, 0};  // without pruning the bounds are computed at the origin and never compared
+  if (prune)
+    for (int a = 0; a < 3; ++a) q[a] = float(d[a]);
+  const float qNorm = std::fabs(q[0]) + std::fabs(q[1]) + std::fabs(q[2]);
+  const __m128 qx = _mm_set1_ps(q[0]), qy = _mm_set1_ps(q[1]), qz = _mm_set1_ps(q[2]), zero = _mm_setzero_ps();
+  const __m128 qn = _mm_set1_ps(qNorm);
+  float bestUp = prune ? pruneAbove(best.squaredDistance) : INFINITY;
+  // Each level pushes at most three more entries than it pops, and the depth is at most 32: 128 hold any tree.
   struct Waiting {
-    uint32_t node;
-    double d2;
+    int32_t node;
+    float d2;
   };
-  std::array<Waiting, 64> stack;
+  std::array<Waiting, 128> stack;
   size_t top = 0;
-  uint32_t current = root;
-  double currentD2 = squaredDistanceToOrientedBox(nodes_[root].box, p);
+  int32_t current = 0;
   for (;;) {
-    if (currentD2 <= best.squaredDistance) {
-      const Node& node = nodes_[current];
-      if (node.count == 0) {
-        const uint32_t a = current + 1, b = node.first;
-        const double da = squaredDistanceToOrientedBox(nodes_[a].box, p),
-                     db = squaredDistanceToOrientedBox(nodes_[b].box, p);
-        const bool aFirst = da <= db;
-        stack[top++] = {aFirst ? b : a, aFirst ? db : da};  // the farther child waits
-        current = aFirst ? a : b;
-        currentD2 = aFirst ? da : db;
-        continue;
-      }
-      visitLeaf(node, p, best);
+    const WideNode& node = wide_[size_t(current)];
+    const auto outside = [&](int a) {
+      const __m128 e = _mm_max_ps(_mm_max_ps(_mm_sub_ps(_mm_load_ps(node.lo[a]), a == 0   ? qx
+                                                                                 : a == 1 ? qy
+                                                                                          : qz),
+                                             _mm_sub_ps(a == 0   ? qx
+                                                        : a == 1 ? qy
+                                                                 : qz,
+                                                        _mm_load_ps(node.hi[a]))),
+                                  zero);
+      return e;
+    };
+    const __m128 allowance = _mm_add_ps(_mm_mul_ps(_mm_add_ps(qn, _mm_load_ps(node.magnitude)), _mm_set1_ps(kRelative)),
+                                        _mm_set1_ps(kAbsolute));
+    const __m128 ex = _mm_max_ps(_mm_sub_ps(outside(0), allowance), zero),
+                 ey = _mm_max_ps(_mm_sub_ps(outside(1), allowance), zero),
+                 ez = _mm_max_ps(_mm_sub_ps(outside(2), allowance), zero);
+    const __m128 lb2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(ex, ex), _mm_mul_ps(ey, ey)), _mm_mul_ps(ez, ez));
+    alignas(16) float bound[4];
+    _mm_store_ps(bound, lb2);
+    unsigned open = unsigned(_mm_movemask_ps(_mm_cmple_ps(lb2, _mm_set1_ps(bestUp)))) & ((1u << node.count) - 1);
+    // The open children pushed farthest first, so the nearest is popped first.
+    const size_t base = top;
+    for (; open != 0; open &= open - 1) {
+      const int lane = __builtin_ctz(open);
+      size_t i = top++;
+      for (; i > base && stack[i - 1].d2 < bound[lane]; --i) stack[i] = stack[i - 1];
+      stack[i] = {node.child[lane], bound[lane]};
     }
-    if (top == 0) return;
-    --top;
-    current = stack[top].node;
-    currentD2 = stack[top].d2;
+    for (;;) {
+      if (top == 0) return;
+      const Waiting next = stack[--top];
+      if (next.d2 > bestUp) continue;
+      if (next.node >= 0) {
+        current = next.node;
+        break;
+      }
+      visitLeaf(leaves_[size_t(~next.node)], p, q, qNorm, bestUp, best);
+      if (prune) bestUp = pruneAbove(best.squaredDistance);
+    }
   }
 }
 

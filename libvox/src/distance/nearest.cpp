@@ -7,6 +7,7 @@
 #include <numeric>
 
 #include <emmintrin.h>
+#include <tbb/parallel_for.h>
 
 namespace vox {
 
@@ -24,6 +25,7 @@ constexpr uint32_t kLeafSize = 4;
 // values that underflow to subnormal floats (a scene far smaller than its distance from the origin).
 constexpr float kRelative = 0x1p-18f;
 constexpr float kAbsolute = 0x1p-100f;
+constexpr float kShrink = 1 - 0x1p-18f;
 // Points farther than this from the origin (in the frame, where the scene's magnitude is in [1, 2)) are searched
 // without float pruning: their squares would leave the float range.
 constexpr double kFloatReach = 0x1p60;
@@ -45,6 +47,17 @@ float floatAbove(double x) { return -floatBelow(-x); }
 float pruneAbove(double best2) {
   const double b = best2 * (1 + 0x1p-20) + 0x1p-126;
   return b < double(std::numeric_limits<float>::max()) ? floatAbove(b) : INFINITY;
+}
+
+// The points whose convex hull holds primitive `id`: a triangle's corners, the corners of a sphere's box.
+template <typename Visit>
+void forHullPoints(const Scene& scene, const std::vector<Box>& boxes, uint32_t id, const Visit& visit) {
+  if (id < scene.triangles.size()) {
+    for (const Vec3& v : scene.triangles[id].v) visit(v);
+    return;
+  }
+  const Box& b = boxes[id];
+  for (int c = 0; c < 8; ++c) visit(Vec3{c & 1 ? b.hi.x : b.lo.x, c & 2 ? b.hi.y : b.lo.y, c & 4 ? b.hi.z : b.lo.z});
 }
 
 double surfaceArea(const Box& b) {
@@ -98,9 +111,12 @@ NearestPrimitive::NearestPrimitive(const Scene& scene) : triangleCount_(uint32_t
       nodeBoxes[i] = unite(nodeBoxes[i], boxes[ids_[s]]);
   }
   origin_ = (nodeBoxes[0].lo + nodeBoxes[0].hi) * 0.5;
+  // Each oriented box depends only on its node's slots: all of them at once.
+  std::vector<FloatBox> floatBoxes(nodes.size());
+  tbb::parallel_for(size_t(0), nodes.size(), [&](size_t i) { floatBoxes[i] = orientedBounds(nodes[i], scene, boxes); });
   wide_.reserve(nodes.size() / 3 + 1);
   leaves_.reserve(nodes.size() / 2 + 1);
-  buildWide(0, nodes, nodeBoxes);
+  buildWide(0, nodes, nodeBoxes, floatBoxes);
 }
 
 // Median split of the centroids on the longest axis of their spread: balanced (depth at most 31 for 2^32
@@ -109,8 +125,11 @@ uint32_t NearestPrimitive::build(uint32_t begin, uint32_t end, const std::vector
                                  std::vector<BinaryNode>& nodes) {
   const uint32_t index = uint32_t(nodes.size());
   nodes.push_back({});
+  nodes[index].begin = begin;
+  nodes[index].end = end;
   if (end - begin <= kLeafSize) {
-    nodes[index] = {begin, end - begin};
+    nodes[index].first = begin;
+    nodes[index].count = end - begin;
     return index;
   }
   Box spread{centroids[ids_[begin]], centroids[ids_[begin]]};
@@ -129,7 +148,7 @@ uint32_t NearestPrimitive::build(uint32_t begin, uint32_t end, const std::vector
 // The four-wide node over binary node `index`: its children, the one of largest surface area replaced by its two
 // until there are four (or only leaves), each child's box converted outward to float about origin_.
 int32_t NearestPrimitive::buildWide(uint32_t index, const std::vector<BinaryNode>& nodes,
-                                    const std::vector<Box>& nodeBoxes) {
+                                    const std::vector<Box>& nodeBoxes, const std::vector<FloatBox>& floatBoxes) {
   std::vector<uint32_t> children{index};
   for (;;) {
     int widest = -1;
@@ -144,20 +163,16 @@ int32_t NearestPrimitive::buildWide(uint32_t index, const std::vector<BinaryNode
   }
   const int32_t self = int32_t(wide_.size());
   wide_.emplace_back();
-  WideNode node;
+  WideNode node{};  // unused lanes: a point box at the origin, masked out
   node.count = uint32_t(children.size());
-  for (int lane = 0; lane < 4; ++lane) {
-    node.child[lane] = 0;
-    node.magnitude[lane] = 0;
-    for (int a = 0; a < 3; ++a) node.lo[a][lane] = node.hi[a][lane] = 0;
-  }
   for (size_t lane = 0; lane < children.size(); ++lane) {
-    const Box& b = nodeBoxes[children[lane]];
+    const FloatBox& box = floatBoxes[children[lane]];
     float magnitude = 0;
     for (int a = 0; a < 3; ++a) {
-      node.lo[a][lane] = floatBelow(b.lo[a] - origin_[a]);
-      node.hi[a][lane] = floatAbove(b.hi[a] - origin_[a]);
-      magnitude += std::max(std::fabs(node.lo[a][lane]), std::fabs(node.hi[a][lane]));
+      node.centre[a][lane] = box.centre[a];
+      node.half[a][lane] = box.half[a];
+      for (int i = 0; i < 3; ++i) node.axis[a][i][lane] = box.axis[a][i];
+      magnitude += std::fabs(box.centre[a]) + box.half[a];
     }
     node.magnitude[lane] = magnitude * (1 + 0x1p-20f);
     const BinaryNode& child = nodes[children[lane]];
@@ -165,11 +180,55 @@ int32_t NearestPrimitive::buildWide(uint32_t index, const std::vector<BinaryNode
       leaves_.push_back(makeLeaf(child));
       node.child[lane] = ~int32_t(leaves_.size() - 1);
     } else {
-      node.child[lane] = buildWide(children[lane], nodes, nodeBoxes);
+      node.child[lane] = buildWide(children[lane], nodes, nodeBoxes, floatBoxes);
     }
   }
   wide_[size_t(self)] = node;
   return self;
+}
+
+// The oriented box of the node's primitives in float, about origin_: the principal axes of their hull points (a
+// tight slab around a flat patch, where an axis-aligned box leaves a wide margin) rounded to float, the centre
+// rounded to float, and the half extents measured along those float axes about that float centre in double, widened
+// for the double projections' rounding and rounded up: every point of every primitive lies inside, exactly.
+NearestPrimitive::FloatBox NearestPrimitive::orientedBounds(const BinaryNode& node, const Scene& scene,
+                                                            const std::vector<Box>& boxes) const {
+  Vec3 sum{0, 0, 0};
+  double count = 0;
+  const auto forPoints = [&](const auto& visit) {
+    for (uint32_t s = node.begin; s < node.end; ++s) forHullPoints(scene, boxes, ids_[s], visit);
+  };
+  forPoints([&](const Vec3& q) { sum = sum + q, ++count; });
+  const Vec3 mean = sum / count;
+  std::array<std::array<double, 3>, 3> covariance{};
+  forPoints([&](const Vec3& q) {
+    const Vec3 d = q - mean;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) covariance[i][j] += d[i] * d[j];
+  });
+  const std::array<Vec3, 3> exact = symmetricEigenvectors(covariance);
+  FloatBox box;
+  std::array<Vec3, 3> axes;
+  for (int a = 0; a < 3; ++a)
+    for (int i = 0; i < 3; ++i) axes[size_t(a)].at(i) = box.axis[a][i] = float(exact[size_t(a)][i]);
+  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi = lo * -1.0;
+  forPoints([&](const Vec3& q) {
+    for (int a = 0; a < 3; ++a) {
+      const double u = dot(axes[size_t(a)], q - mean);
+      lo.at(a) = std::min(lo[a], u), hi.at(a) = std::max(hi[a], u);
+    }
+  });
+  Vec3 centre = mean - origin_;
+  for (int a = 0; a < 3; ++a) centre = centre + axes[size_t(a)] * (0.5 * (lo[a] + hi[a]));
+  for (int a = 0; a < 3; ++a) centre.at(a) = box.centre[a] = float(centre[a]);
+  Vec3 half{0, 0, 0};
+  forPoints([&](const Vec3& q) {
+    for (int a = 0; a < 3; ++a) half.at(a) = std::max(half[a], std::fabs(dot(axes[size_t(a)], q - origin_ - centre)));
+  });
+  const double widen =
+      0x1p-40 * (half.x + half.y + half.z + std::fabs(centre.x) + std::fabs(centre.y) + std::fabs(centre.z));
+  for (int a = 0; a < 3; ++a) box.half[a] = floatAbove(half[a] + widen);
+  return box;
 }
 
 // A leaf's float rows (WideLeaf). Each triangle's allowance: the double bound's own (slack |p - a|_1 + slackAt0,
@@ -227,10 +286,10 @@ NearestHit NearestPrimitive::nearest(const Vec3& p, double bound2) const {
   return best;
 }
 
-// The leaf's triangles' float lower bounds, four at once; the survivors, in slot order, get the double route (which
-// may still prune with the best as it is by then) as the binary double search gave them.
-void NearestPrimitive::visitLeaf(const WideLeaf& leaf, const Vec3& p, const float (&q)[3], float qNorm, float bestUp,
-                                 NearestHit& best) const {
+// The leaf's triangles' float lower bounds, four at once; the survivors get the double route (which may still prune
+// with the best as it is by then), as the double search gave it to every triangle it reached.
+void NearestPrimitive::visitLeaf(const WideLeaf& leaf, const Vec3& p, const float (&q)[3], float qNorm, bool prune,
+                                 float bestUp, NearestHit& best) const {
   const __m128 qx = _mm_set1_ps(q[0]), qy = _mm_set1_ps(q[1]), qz = _mm_set1_ps(q[2]), zero = _mm_setzero_ps();
   const auto row = [&](const float(&v)[3][4], const float* w) {
     const __m128 d = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_load_ps(v[0]), qx), _mm_mul_ps(_mm_load_ps(v[1]), qy)),
@@ -245,13 +304,28 @@ void NearestPrimitive::visitLeaf(const WideLeaf& leaf, const Vec3& p, const floa
   const __m128 hl = _mm_max_ps(_mm_sub_ps(h, allowance), zero), sl = _mm_max_ps(_mm_sub_ps(s, allowance), zero);
   const __m128 lb2 = _mm_add_ps(_mm_mul_ps(hl, hl), _mm_mul_ps(sl, sl));
   unsigned open = unsigned(_mm_movemask_ps(_mm_cmple_ps(lb2, _mm_set1_ps(bestUp)))) & ((1u << leaf.count) - 1);
+  if (open == 0) return;
+  // The survivors nearest bound first, each bound checked again against the best so far: the first exact distance
+  // then prunes most of the rest. The answer does not depend on the order (ties go to the lowest id in any order).
+  alignas(16) float bound[4];
+  _mm_store_ps(bound, lb2);
+  int order[4];
+  int count = 0;
   for (; open != 0; open &= open - 1) {
-    const uint32_t slot = leaf.first + uint32_t(__builtin_ctz(open));
+    const int lane = __builtin_ctz(open);
+    int i = count++;
+    for (; i > 0 && bound[order[i - 1]] > bound[lane]; --i) order[i] = order[i - 1];
+    order[i] = lane;
+  }
+  for (int k = 0; k < count; ++k) {
+    if (k > 0 && bound[order[k]] > bestUp) break;  // the rest are farther still
+    const uint32_t slot = leaf.first + uint32_t(order[k]);
     const double d2 = squaredDistanceTo(slot, p, best.squaredDistance);
     const int64_t id = ids_[slot];
     if (d2 < best.squaredDistance || (d2 == best.squaredDistance && (best.primitive < 0 || id < best.primitive))) {
       best.squaredDistance = d2;
       best.primitive = id;
+      if (prune) bestUp = pruneAbove(d2);
     }
   }
 }
@@ -279,23 +353,22 @@ void NearestPrimitive::search(const Vec3& p, NearestHit& best) const {
   int32_t current = 0;
   for (;;) {
     const WideNode& node = wide_[size_t(current)];
-    const auto outside = [&](int a) {
-      const __m128 e = _mm_max_ps(_mm_max_ps(_mm_sub_ps(_mm_load_ps(node.lo[a]), a == 0   ? qx
-                                                                                 : a == 1 ? qy
-                                                                                          : qz),
-                                             _mm_sub_ps(a == 0   ? qx
-                                                        : a == 1 ? qy
-                                                                 : qz,
-                                                        _mm_load_ps(node.hi[a]))),
-                                  zero);
-      return e;
-    };
+    const __m128 dx = _mm_sub_ps(qx, _mm_load_ps(node.centre[0])), dy = _mm_sub_ps(qy, _mm_load_ps(node.centre[1])),
+                 dz = _mm_sub_ps(qz, _mm_load_ps(node.centre[2]));
     const __m128 allowance = _mm_add_ps(_mm_mul_ps(_mm_add_ps(qn, _mm_load_ps(node.magnitude)), _mm_set1_ps(kRelative)),
                                         _mm_set1_ps(kAbsolute));
-    const __m128 ex = _mm_max_ps(_mm_sub_ps(outside(0), allowance), zero),
-                 ey = _mm_max_ps(_mm_sub_ps(outside(1), allowance), zero),
-                 ez = _mm_max_ps(_mm_sub_ps(outside(2), allowance), zero);
-    const __m128 lb2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(ex, ex), _mm_mul_ps(ey, ey)), _mm_mul_ps(ez, ez));
+    const auto outside = [&](int a) {
+      const __m128 u = _mm_add_ps(
+          _mm_add_ps(_mm_mul_ps(_mm_load_ps(node.axis[a][0]), dx), _mm_mul_ps(_mm_load_ps(node.axis[a][1]), dy)),
+          _mm_mul_ps(_mm_load_ps(node.axis[a][2]), dz));
+      const __m128 e = _mm_sub_ps(_mm_max_ps(u, _mm_sub_ps(zero, u)), _mm_add_ps(_mm_load_ps(node.half[a]), allowance));
+      return _mm_max_ps(e, zero);
+    };
+    const __m128 ex = outside(0), ey = outside(1), ez = outside(2);
+    // Float axes are orthonormal only to about 2^-23: the sum of squares along them may exceed the squared distance
+    // by that much, which kShrink undoes.
+    const __m128 lb2 = _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(ex, ex), _mm_mul_ps(ey, ey)), _mm_mul_ps(ez, ez)),
+                                  _mm_set1_ps(kShrink));
     alignas(16) float bound[4];
     _mm_store_ps(bound, lb2);
     unsigned open = unsigned(_mm_movemask_ps(_mm_cmple_ps(lb2, _mm_set1_ps(bestUp)))) & ((1u << node.count) - 1);
@@ -315,7 +388,7 @@ void NearestPrimitive::search(const Vec3& p, NearestHit& best) const {
         current = next.node;
         break;
       }
-      visitLeaf(leaves_[size_t(~next.node)], p, q, qNorm, bestUp, best);
+      visitLeaf(leaves_[size_t(~next.node)], p, q, qNorm, prune, bestUp, best);
       if (prune) bestUp = pruneAbove(best.squaredDistance);
     }
   }

@@ -46,12 +46,15 @@ class NearestPrimitive {
   size_t primitiveCount() const { return ids_.size(); }
 
  private:
-  // Four children's boxes in float, relative to origin_, rounded outward (each holds every point of its primitives),
-  // as structure of arrays so that one SSE2 pass tests all four. A ray could test the same boxes (a slab test on
-  // the same lanes, its rounding bounded the same way): the nodes carry nothing particular to points.
+  // Four children's oriented boxes in float, relative to origin_ (each holds every point of its primitives, about
+  // its float centre along its float axes), as structure of arrays so that one SSE2 pass tests all four. A ray could
+  // test the same boxes (a slab test in each box's axes, on the same lanes, its rounding bounded the same way): the
+  // nodes carry nothing particular to points.
   struct alignas(16) WideNode {
-    float lo[3][4], hi[3][4];
-    float magnitude[4];  // sum over the axes of max(|lo|, |hi|): the size the rounding allowance scales with
+    float centre[3][4];
+    float axis[3][3][4];  // axis a's component i; orthonormal to float rounding
+    float half[3][4];
+    float magnitude[4];  // |centre|_1 plus the half extents: the size the rounding allowance scales with
     int32_t child[4];    // >= 0: a node; < 0: leaf ~child; unused lanes hold a box no point is near, masked out
     uint32_t count = 0;  // children in use
   };
@@ -66,15 +69,21 @@ class NearestPrimitive {
     uint32_t first = 0, count = 0;  // slots
   };
   struct BinaryNode {
-    uint32_t first = 0;  // leaf: its first slot; inner: the second child (the first is the next node)
-    uint32_t count = 0;  // primitives of a leaf; 0 for an inner node
+    uint32_t first = 0;           // leaf: its first slot; inner: the second child (the first is the next node)
+    uint32_t count = 0;           // primitives of a leaf; 0 for an inner node
+    uint32_t begin = 0, end = 0;  // its slots
+  };
+  struct FloatBox {  // one child's lane of a WideNode
+    float centre[3], axis[3][3], half[3];
   };
   double squaredDistanceTo(uint32_t slot, const Vec3& p, double bound2) const;
   void search(const Vec3& p, NearestHit& best) const;
-  void visitLeaf(const WideLeaf& leaf, const Vec3& p, const float (&q)[3], float qNorm, float bestUp,
+  void visitLeaf(const WideLeaf& leaf, const Vec3& p, const float (&q)[3], float qNorm, bool prune, float bestUp,
                  NearestHit& best) const;
   uint32_t build(uint32_t begin, uint32_t end, const std::vector<Vec3>& centroids, std::vector<BinaryNode>& nodes);
-  int32_t buildWide(uint32_t index, const std::vector<BinaryNode>& nodes, const std::vector<Box>& nodeBoxes);
+  int32_t buildWide(uint32_t index, const std::vector<BinaryNode>& nodes, const std::vector<Box>& nodeBoxes,
+                    const std::vector<FloatBox>& floatBoxes);
+  FloatBox orientedBounds(const BinaryNode& node, const Scene& scene, const std::vector<Box>& boxes) const;
   WideLeaf makeLeaf(const BinaryNode& node) const;
 
   std::vector<WideNode> wide_;  // the root first

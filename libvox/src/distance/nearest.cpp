@@ -250,6 +250,14 @@ NearestPrimitive::WideLeaf NearestPrimitive::makeLeaf(const BinaryNode& node) co
     for (int e = 0; e < 3; ++e) {
       for (int a = 0; a < 3; ++a) leaf.e[e][a][lane] = float(b.edgeNormals[e][a]);
       leaf.ew[e][lane] = float(dot(b.edgeNormals[e], t.v[e] - origin_));
+      // Corner e lies on edges e and e + 2 (e - 1): the bisector of their outward normals is a positive sum of the
+      // two, so the triangle lies inside its half-plane through the corner too. Where the two normals nearly
+      // cancel (a needle's tip) its direction is ill-conditioned: a zero row.
+      const Vec3 bisector = b.edgeNormals[e] + b.edgeNormals[(e + 2) % 3];
+      if (!(length(bisector) > 0.25)) continue;
+      const Vec3 m = normalize(bisector);
+      for (int a = 0; a < 3; ++a) leaf.e[3 + e][a][lane] = float(m[a]);
+      leaf.ew[3 + e][lane] = float(dot(m, t.v[e] - origin_));
     }
     const double k1 = b.slack + double(kRelative);
     leaf.k1[lane] = floatAbove(k1);
@@ -298,8 +306,8 @@ void NearestPrimitive::visitLeaf(const WideLeaf& leaf, const Vec3& p, const floa
   };
   const __m128 plane = row(leaf.n, leaf.w);
   const __m128 h = _mm_max_ps(plane, _mm_sub_ps(zero, plane));
-  const __m128 s =
-      _mm_max_ps(_mm_max_ps(row(leaf.e[0], leaf.ew[0]), row(leaf.e[1], leaf.ew[1])), row(leaf.e[2], leaf.ew[2]));
+  __m128 s = row(leaf.e[0], leaf.ew[0]);
+  for (int e = 1; e < 6; ++e) s = _mm_max_ps(s, row(leaf.e[e], leaf.ew[e]));
   const __m128 allowance = _mm_add_ps(_mm_mul_ps(_mm_load_ps(leaf.k1), _mm_set1_ps(qNorm)), _mm_load_ps(leaf.k0));
   const __m128 hl = _mm_max_ps(_mm_sub_ps(h, allowance), zero), sl = _mm_max_ps(_mm_sub_ps(s, allowance), zero);
   const __m128 lb2 = _mm_add_ps(_mm_mul_ps(hl, hl), _mm_mul_ps(sl, sl));

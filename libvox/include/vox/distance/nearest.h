@@ -58,13 +58,14 @@ class NearestPrimitive {
     int32_t child[4];    // >= 0: a node; < 0: leaf ~child; unused lanes hold a box no point is near, masked out
     uint32_t count = 0;  // children in use
   };
-  // A leaf's up to four primitives' lower bounds as float rows relative to origin_ (the triangle's plane n.q = w and
-  // its edges' outward half-planes e.q = ew), with the allowance k1 |q|_1 + k0 that keeps each below the double
-  // bound of squaredDistanceToTriangleWithin. Spheres, ellipsoids, needles and unused lanes hold zero rows: a bound of
-  // 0 that prunes nothing.
+  // A leaf's up to four primitives' lower bounds as float rows relative to origin_: the triangle's plane n.q = w, and
+  // six outward half-planes of its own plane that hold it, e.q = ew: its edges' and, at each corner, the one whose
+  // normal bisects the two edges' (the distance in a corner's region is then bounded to within cos 30 degrees or so,
+  // where the edges alone give cos 60). The allowance k1 |q|_1 + k0 keeps each below the exact double distance
+  // (nearest.cpp). Spheres, ellipsoids, needles and unused lanes hold zero rows: a bound of 0 that prunes nothing.
   struct alignas(16) WideLeaf {
     float n[3][4], w[4];
-    float e[3][3][4], ew[3][4];
+    float e[6][3][4], ew[6][4];
     float k1[4], k0[4];
     uint32_t first = 0, count = 0;  // slots
   };

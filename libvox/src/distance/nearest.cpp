@@ -20,11 +20,17 @@ constexpr uint32_t kLeafSize = 4;
 // are no larger, so the float bound errs from the same bound in real arithmetic by at most 9 * 2^-24 of that size
 // (sums, products and the conversions of q, the normals and the offsets). 2^-18 is more than four times that, so
 // the allowance also covers the double route's own rounding (about 2^-50 of the same size: the exact distance
-// computed relative to p, the double lower bound) with room to spare: a bound lowered by it is at most the double
-// bound it stands for, and below the computed exact distance of every primitive it bounds. kAbsolute covers the
-// values that underflow to subnormal floats (a scene far smaller than its distance from the origin).
+// computed relative to p, and for triangles the double bound's own allowance is added) with room to spare: a bound
+// lowered by it lies strictly below the computed exact distance of every primitive it bounds, by at least a
+// quarter of the allowance (a box's per-axis lowering shortens its distance vector by at least a quarter of it).
+// pruneAbove then adds a relative margin for the float squares and sums, so whatever the float test skips, the
+// double route would have computed and rejected (a distance above the best so far): the answer is unchanged.
+// kAbsolute covers the values that underflow to subnormal floats (a scene far smaller than its distance from the
+// origin). tests/nearest_test.cpp fails without these allowances.
 constexpr float kRelative = 0x1p-18f;
 constexpr float kAbsolute = 0x1p-100f;
+// Float axes are orthonormal only to about 2^-23: a sum of squares along them may exceed the squared length by
+// about 3 * 2^-23, which this factor undoes.
 constexpr float kShrink = 1 - 0x1p-18f;
 // Points farther than this from the origin (in the frame, where the scene's magnitude is in [1, 2)) are searched
 // without float pruning: their squares would leave the float range.
@@ -43,10 +49,12 @@ float floatAbove(double x) { return -floatBelow(-x); }
 
 // The squared distance below which a bound must lie for the search to open what it bounds, as a float rounded up:
 // a float bound above it exceeds best2 (1 + 2^-21) in real arithmetic, after the float squares' and sums' own
-// rounding (2^-22 relative, 2^-148 absolute), so the double route would have pruned it too.
+// rounding (2^-22 relative, 2^-148 absolute), so the double route would have pruned it too. b is at least 2^-126, a
+// normal float, so rounding b (1 + 2^-22) to the nearest float (at most 2^-24 of it away) gives a float above b,
+// without floatAbove's nextafter on this hot path.
 float pruneAbove(double best2) {
   const double b = best2 * (1 + 0x1p-20) + 0x1p-126;
-  return b < double(std::numeric_limits<float>::max()) ? floatAbove(b) : INFINITY;
+  return b < double(std::numeric_limits<float>::max()) ? float(b * (1 + 0x1p-22)) : INFINITY;
 }
 
 // The points whose convex hull holds primitive `id`: a triangle's corners, the corners of a sphere's box.
@@ -373,8 +381,6 @@ void NearestPrimitive::search(const Vec3& p, NearestHit& best) const {
       return _mm_max_ps(e, zero);
     };
     const __m128 ex = outside(0), ey = outside(1), ez = outside(2);
-    // Float axes are orthonormal only to about 2^-23: the sum of squares along them may exceed the squared distance
-    // by that much, which kShrink undoes.
     const __m128 lb2 = _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(ex, ex), _mm_mul_ps(ey, ey)), _mm_mul_ps(ez, ez)),
                                   _mm_set1_ps(kShrink));
     alignas(16) float bound[4];

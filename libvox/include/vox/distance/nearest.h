@@ -24,7 +24,7 @@ struct NearestHit {
 
 class NearestPrimitive {
  public:
-  // Copies what it needs from `scene` (about 300 bytes per primitive, with the nodes). Throws InputError for a singular
+  // Copies what it needs from `scene` (about 350 bytes per primitive, with the nodes). Throws InputError for a singular
   // sphere transform (ellipsoidShape).
   explicit NearestPrimitive(const Scene& scene);
   // The same over the scene scaled into `frame` (vox/core/power_of_two_frame.h): points given to the queries below
@@ -60,9 +60,10 @@ class NearestPrimitive {
   };
   // A leaf's up to four primitives' lower bounds as float rows relative to origin_: the triangle's plane n.q = w, and
   // six outward half-planes of its own plane that hold it, e.q = ew: its edges' and, at each corner, the one whose
-  // normal bisects the two edges' (the distance in a corner's region is then bounded to within cos 30 degrees or so,
-  // where the edges alone give cos 60). The allowance k1 |q|_1 + k0 keeps each below the exact double distance
-  // (nearest.cpp). Spheres, ellipsoids, needles and unused lanes hold zero rows: a bound of 0 that prunes nothing.
+  // normal bisects the two edges' (in a corner's region of angle A the bound is then within cos((180 - A) / 4) of
+  // the distance in the plane, where the edges alone give cos((180 - A) / 2)). The allowance k1 |q|_1 + k0 keeps each
+  // below the exact double distance (nearest.cpp). Spheres, ellipsoids, needles and unused lanes hold zero rows: a
+  // bound of 0 that prunes nothing.
   struct alignas(16) WideLeaf {
     float n[3][4], w[4];
     float e[6][3][4], ew[6][4];

@@ -6,6 +6,7 @@
 #include <limits>
 #include <numeric>
 
+#include <emmintrin.h>
 #include <tbb/parallel_for.h>
 
 namespace vox {
@@ -14,20 +15,46 @@ namespace {
 
 constexpr uint32_t kLeafSize = 4;
 
+// The float bounds' rounding allowance, per unit of |q|_1 plus the box's or triangle's own magnitude (about the
+// origin): a float conversion errs by 2^-24 of its value, and each bound is a few float operations on values that
+// are no larger, so the float bound errs from the same bound in real arithmetic by at most 9 * 2^-24 of that size
+// (sums, products and the conversions of q, the normals and the offsets). 2^-18 is more than four times that, so
+// the allowance also covers the double route's own rounding (about 2^-50 of the same size: the exact distance
+// computed relative to p, and for triangles the double bound's own allowance is added) with room to spare: a bound
+// lowered by it lies strictly below the computed exact distance of every primitive it bounds, by at least a
+// quarter of the allowance (a box's per-axis lowering shortens its distance vector by at least a quarter of it).
+// pruneAbove then adds a relative margin for the float squares and sums, so whatever the float test skips, the
+// double route would have computed and rejected (a distance above the best so far): the answer is unchanged.
+// kAbsolute covers the values that underflow to subnormal floats (a scene far smaller than its distance from the
+// origin). tests/nearest_test.cpp fails without these allowances.
+constexpr float kRelative = 0x1p-18f;
+constexpr float kAbsolute = 0x1p-100f;
+// Float axes are orthonormal only to about 2^-23: a sum of squares along them may exceed the squared length by
+// about 3 * 2^-23, which this factor undoes.
+constexpr float kShrink = 1 - 0x1p-18f;
+// Points farther than this from the origin (in the frame, where the scene's magnitude is in [1, 2)) are searched
+// without float pruning: their squares would leave the float range.
+constexpr double kFloatReach = 0x1p60;
+
 Box unite(const Box& a, const Box& b) { return {minVec(a.lo, b.lo), maxVec(a.hi, b.hi)}; }
 
-// A lower bound of the squared distance from p to anything inside the box: the box's own distance, less a rounding
-// allowance (the axes are orthonormal only to rounding, and the projections round relative to |p - centre|).
-double squaredDistanceToOrientedBox(const NearestPrimitive::OrientedBox& b, const Vec3& p) {
-  const Vec3 d = p - b.centre;
-  const double err = 1e-13 * (std::fabs(d.x) + std::fabs(d.y) + std::fabs(d.z));
-  double sum = 0;
-  for (int a = 0; a < 3; ++a) {
-    const double outside = std::fabs(dot(b.axes[a], d)) - b.half[a] - err;
-    const double e = outside > 0 ? outside : 0.0;  // a maxsd, where std::max's NaN rules make a branch
-    sum += e * e;
-  }
-  return sum * (1 - 1e-12);
+// The float at most x (at least x), one float step further out: the double x may itself have been rounded, by far
+// less than a float step.
+float floatBelow(double x) {
+  float f = float(x);
+  if (double(f) > x) f = std::nextafter(f, -INFINITY);
+  return std::nextafter(f, -INFINITY);
+}
+float floatAbove(double x) { return -floatBelow(-x); }
+
+// The squared distance below which a bound must lie for the search to open what it bounds, as a float rounded up:
+// a float bound above it exceeds best2 (1 + 2^-21) in real arithmetic, after the float squares' and sums' own
+// rounding (2^-22 relative, 2^-148 absolute), so the double route would have pruned it too. b is at least 2^-126, a
+// normal float, so rounding b (1 + 2^-22) to the nearest float (at most 2^-24 of it away) gives a float above b,
+// without floatAbove's nextafter on this hot path.
+float pruneAbove(double best2) {
+  const double b = best2 * (1 + 0x1p-20) + 0x1p-126;
+  return b < double(std::numeric_limits<float>::max()) ? float(b * (1 + 0x1p-22)) : INFINITY;
 }
 
 // The points whose convex hull holds primitive `id`: a triangle's corners, the corners of a sphere's box.
@@ -39,6 +66,11 @@ void forHullPoints(const Scene& scene, const std::vector<Box>& boxes, uint32_t i
   }
   const Box& b = boxes[id];
   for (int c = 0; c < 8; ++c) visit(Vec3{c & 1 ? b.hi.x : b.lo.x, c & 2 ? b.hi.y : b.lo.y, c & 4 ? b.hi.z : b.lo.z});
+}
+
+double surfaceArea(const Box& b) {
+  const Vec3 e = b.hi - b.lo;
+  return e.x * e.y + e.y * e.z + e.z * e.x;
 }
 
 }  // namespace
@@ -59,21 +91,14 @@ NearestPrimitive::NearestPrimitive(const Scene& scene) : triangleCount_(uint32_t
   }
   ids_.resize(n);
   std::iota(ids_.begin(), ids_.end(), 0u);
-  if (n > 0) {
-    nodes_.reserve(2 * (n / kLeafSize + 1));
-    std::vector<std::array<uint32_t, 2>> ranges;  // each node's slots
-    build(0, uint32_t(n), centroids, ranges, 0);
-    // Each box depends only on its node's slots: all of them at once.
-    tbb::parallel_for(size_t(0), nodes_.size(),
-                      [&](size_t i) { nodes_[i].box = orientedBounds(ranges[i][0], ranges[i][1], scene, boxes); });
-  }
-  // Triangles copied in leaf order, so a leaf's are adjacent in memory.
   triangles_.resize(n);
   bounds_.resize(n);
   slotOf_.resize(n);
-  leafOf_.resize(n);
-  for (uint32_t i = 0; i < nodes_.size(); ++i)
-    for (uint32_t s = nodes_[i].first; s < nodes_[i].first + nodes_[i].count; ++s) leafOf_[s] = i;
+  if (n == 0) return;
+  std::vector<BinaryNode> nodes;
+  nodes.reserve(2 * (n / kLeafSize + 1));
+  build(0, uint32_t(n), centroids, nodes);
+  // Triangles copied in leaf order, so a leaf's are adjacent in memory.
   for (size_t s = 0; s < n; ++s) slotOf_[ids_[s]] = uint32_t(s);
   for (size_t s = 0; s < n; ++s)
     if (ids_[s] < triangleCount_) {
@@ -81,70 +106,172 @@ NearestPrimitive::NearestPrimitive(const Scene& scene) : triangleCount_(uint32_t
       triangles_[s] = t;
       bounds_[s] = triangleLowerBound(t);
     }
+  // Each node's box, children after their parent in `nodes`: from the last node back.
+  std::vector<Box> nodeBoxes(nodes.size());
+  for (size_t i = nodes.size(); i-- > 0;) {
+    const BinaryNode& node = nodes[i];
+    if (node.count == 0) {
+      nodeBoxes[i] = unite(nodeBoxes[i + 1], nodeBoxes[node.first]);
+      continue;
+    }
+    nodeBoxes[i] = boxes[ids_[node.first]];
+    for (uint32_t s = node.first + 1; s < node.first + node.count; ++s)
+      nodeBoxes[i] = unite(nodeBoxes[i], boxes[ids_[s]]);
+  }
+  origin_ = (nodeBoxes[0].lo + nodeBoxes[0].hi) * 0.5;
+  // Each oriented box depends only on its node's slots: all of them at once.
+  std::vector<FloatBox> floatBoxes(nodes.size());
+  tbb::parallel_for(size_t(0), nodes.size(), [&](size_t i) { floatBoxes[i] = orientedBounds(nodes[i], scene, boxes); });
+  wide_.reserve(nodes.size() / 3 + 1);
+  leaves_.reserve(nodes.size() / 2 + 1);
+  buildWide(0, nodes, nodeBoxes, floatBoxes);
 }
 
-// The oriented box of the primitives in slots [begin, end): the principal axes of their hull points (a tight slab
-// around a flat patch, where an axis-aligned box leaves a wide margin), its extents taken about the final centre and
-// widened for the projections' rounding, so that every point of every primitive lies inside.
-NearestPrimitive::OrientedBox NearestPrimitive::orientedBounds(uint32_t begin, uint32_t end, const Scene& scene,
-                                                               const std::vector<Box>& boxes) const {
-  Vec3 sum{0, 0, 0};
-  double count = 0;
-  for (uint32_t s = begin; s < end; ++s)
-    forHullPoints(scene, boxes, ids_[s], [&](const Vec3& q) { sum = sum + q, ++count; });
-  const Vec3 mean = sum / count;
-  std::array<std::array<double, 3>, 3> covariance{};
-  for (uint32_t s = begin; s < end; ++s)
-    forHullPoints(scene, boxes, ids_[s], [&](const Vec3& q) {
-      const Vec3 d = q - mean;
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) covariance[i][j] += d[i] * d[j];
-    });
-  OrientedBox box;
-  box.axes = symmetricEigenvectors(covariance);
-  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi = lo * -1.0;
-  for (uint32_t s = begin; s < end; ++s)
-    forHullPoints(scene, boxes, ids_[s], [&](const Vec3& q) {
-      for (int a = 0; a < 3; ++a) {
-        const double u = dot(box.axes[a], q - mean);
-        lo.at(a) = std::min(lo[a], u), hi.at(a) = std::max(hi[a], u);
-      }
-    });
-  box.centre = mean;
-  for (int a = 0; a < 3; ++a) box.centre = box.centre + box.axes[a] * (0.5 * (lo[a] + hi[a]));
-  box.half = {0, 0, 0};
-  for (uint32_t s = begin; s < end; ++s)
-    forHullPoints(scene, boxes, ids_[s], [&](const Vec3& q) {
-      for (int a = 0; a < 3; ++a) box.half.at(a) = std::max(box.half[a], std::fabs(dot(box.axes[a], q - box.centre)));
-    });
-  const double widen = 1e-12 * (box.half.x + box.half.y + box.half.z);
-  for (int a = 0; a < 3; ++a) box.half.at(a) = box.half[a] * (1 + 1e-12) + widen;
-  return box;
-}
-
-// Median split of the centroids on the longest axis of their spread: balanced, and built in O(n log n).
+// Median split of the centroids on the longest axis of their spread: balanced (depth at most 31 for 2^32
+// primitives), and built in O(n log n).
 uint32_t NearestPrimitive::build(uint32_t begin, uint32_t end, const std::vector<Vec3>& centroids,
-                                 std::vector<std::array<uint32_t, 2>>& ranges, uint32_t parent) {
-  const uint32_t index = uint32_t(nodes_.size());
-  nodes_.push_back({});
-  ranges.push_back({begin, end});
-  nodes_[index].parent = parent;
-  Box spread{centroids[ids_[begin]], centroids[ids_[begin]]};
-  for (uint32_t s = begin + 1; s < end; ++s) spread = unite(spread, {centroids[ids_[s]], centroids[ids_[s]]});
+                                 std::vector<BinaryNode>& nodes) {
+  const uint32_t index = uint32_t(nodes.size());
+  nodes.push_back({});
+  nodes[index].begin = begin;
+  nodes[index].end = end;
   if (end - begin <= kLeafSize) {
-    nodes_[index].first = begin;
-    nodes_[index].count = end - begin;
+    nodes[index].first = begin;
+    nodes[index].count = end - begin;
     return index;
   }
+  Box spread{centroids[ids_[begin]], centroids[ids_[begin]]};
+  for (uint32_t s = begin + 1; s < end; ++s) spread = unite(spread, {centroids[ids_[s]], centroids[ids_[s]]});
   const Vec3 extent = spread.hi - spread.lo;
   const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
   const uint32_t mid = begin + (end - begin) / 2;
   std::nth_element(ids_.begin() + begin, ids_.begin() + mid, ids_.begin() + end, [&](uint32_t a, uint32_t b) {
     return centroids[a][axis] != centroids[b][axis] ? centroids[a][axis] < centroids[b][axis] : a < b;
   });
-  build(begin, mid, centroids, ranges, index);
-  nodes_[index].first = build(mid, end, centroids, ranges, index);
+  build(begin, mid, centroids, nodes);
+  nodes[index].first = build(mid, end, centroids, nodes);
   return index;
+}
+
+// The four-wide node over binary node `index`: its children, the one of largest surface area replaced by its two
+// until there are four (or only leaves), each child's box converted outward to float about origin_.
+int32_t NearestPrimitive::buildWide(uint32_t index, const std::vector<BinaryNode>& nodes,
+                                    const std::vector<Box>& nodeBoxes, const std::vector<FloatBox>& floatBoxes) {
+  std::vector<uint32_t> children{index};
+  for (;;) {
+    int widest = -1;
+    for (size_t c = 0; c < children.size(); ++c)
+      if (nodes[children[c]].count == 0 &&
+          (widest < 0 || surfaceArea(nodeBoxes[children[c]]) > surfaceArea(nodeBoxes[children[size_t(widest)]])))
+        widest = int(c);
+    if (widest < 0 || (children.size() > 1 && children.size() + 1 > 4)) break;
+    const uint32_t inner = children[size_t(widest)];
+    children[size_t(widest)] = inner + 1;
+    children.insert(children.begin() + widest + 1, nodes[inner].first);
+  }
+  const int32_t self = int32_t(wide_.size());
+  wide_.emplace_back();
+  WideNode node{};  // unused lanes: a point box at the origin, masked out
+  node.count = uint32_t(children.size());
+  for (size_t lane = 0; lane < children.size(); ++lane) {
+    const FloatBox& box = floatBoxes[children[lane]];
+    float magnitude = 0;
+    for (int a = 0; a < 3; ++a) {
+      node.centre[a][lane] = box.centre[a];
+      node.half[a][lane] = box.half[a];
+      for (int i = 0; i < 3; ++i) node.axis[a][i][lane] = box.axis[a][i];
+      magnitude += std::fabs(box.centre[a]) + box.half[a];
+    }
+    node.magnitude[lane] = magnitude * (1 + 0x1p-20f);
+    const BinaryNode& child = nodes[children[lane]];
+    if (child.count > 0) {
+      leaves_.push_back(makeLeaf(child));
+      node.child[lane] = ~int32_t(leaves_.size() - 1);
+    } else {
+      node.child[lane] = buildWide(children[lane], nodes, nodeBoxes, floatBoxes);
+    }
+  }
+  wide_[size_t(self)] = node;
+  return self;
+}
+
+// The oriented box of the node's primitives in float, about origin_: the principal axes of their hull points (a
+// tight slab around a flat patch, where an axis-aligned box leaves a wide margin) rounded to float, the centre
+// rounded to float, and the half extents measured along those float axes about that float centre in double, widened
+// for the double projections' rounding and rounded up: every point of every primitive lies inside, exactly.
+NearestPrimitive::FloatBox NearestPrimitive::orientedBounds(const BinaryNode& node, const Scene& scene,
+                                                            const std::vector<Box>& boxes) const {
+  Vec3 sum{0, 0, 0};
+  double count = 0;
+  const auto forPoints = [&](const auto& visit) {
+    for (uint32_t s = node.begin; s < node.end; ++s) forHullPoints(scene, boxes, ids_[s], visit);
+  };
+  forPoints([&](const Vec3& q) { sum = sum + q, ++count; });
+  const Vec3 mean = sum / count;
+  std::array<std::array<double, 3>, 3> covariance{};
+  forPoints([&](const Vec3& q) {
+    const Vec3 d = q - mean;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) covariance[i][j] += d[i] * d[j];
+  });
+  const std::array<Vec3, 3> exact = symmetricEigenvectors(covariance);
+  FloatBox box;
+  std::array<Vec3, 3> axes;
+  for (int a = 0; a < 3; ++a)
+    for (int i = 0; i < 3; ++i) axes[size_t(a)].at(i) = box.axis[a][i] = float(exact[size_t(a)][i]);
+  Vec3 lo{INFINITY, INFINITY, INFINITY}, hi = lo * -1.0;
+  forPoints([&](const Vec3& q) {
+    for (int a = 0; a < 3; ++a) {
+      const double u = dot(axes[size_t(a)], q - mean);
+      lo.at(a) = std::min(lo[a], u), hi.at(a) = std::max(hi[a], u);
+    }
+  });
+  Vec3 centre = mean - origin_;
+  for (int a = 0; a < 3; ++a) centre = centre + axes[size_t(a)] * (0.5 * (lo[a] + hi[a]));
+  for (int a = 0; a < 3; ++a) centre.at(a) = box.centre[a] = float(centre[a]);
+  Vec3 half{0, 0, 0};
+  forPoints([&](const Vec3& q) {
+    for (int a = 0; a < 3; ++a) half.at(a) = std::max(half[a], std::fabs(dot(axes[size_t(a)], q - origin_ - centre)));
+  });
+  const double widen =
+      0x1p-40 * (half.x + half.y + half.z + std::fabs(centre.x) + std::fabs(centre.y) + std::fabs(centre.z));
+  for (int a = 0; a < 3; ++a) box.half[a] = floatAbove(half[a] + widen);
+  return box;
+}
+
+// A leaf's float rows (WideLeaf). Each triangle's allowance: the double bound's own (slack |p - a|_1 + slackAt0,
+// with |p - a|_1 at most |q|_1 + |a - origin|_1) plus kRelative of the magnitudes the float rows are computed from.
+NearestPrimitive::WideLeaf NearestPrimitive::makeLeaf(const BinaryNode& node) const {
+  WideLeaf leaf{};
+  leaf.first = node.first;
+  leaf.count = node.count;
+  const auto l1 = [](const Vec3& v) { return std::fabs(v.x) + std::fabs(v.y) + std::fabs(v.z); };
+  for (uint32_t lane = 0; lane < node.count; ++lane) {
+    const uint32_t slot = node.first + lane;
+    if (ids_[slot] >= triangleCount_ || !bounds_[slot].usable) continue;  // zero rows: never pruned
+    const Triangle& t = triangles_[slot];
+    const TriangleLowerBound& b = bounds_[slot];
+    double magnitude = 0;
+    for (const Vec3& v : t.v) magnitude = std::max(magnitude, l1(v - origin_));
+    for (int a = 0; a < 3; ++a) leaf.n[a][lane] = float(b.normal[a]);
+    leaf.w[lane] = float(dot(b.normal, t.v[0] - origin_));
+    for (int e = 0; e < 3; ++e) {
+      for (int a = 0; a < 3; ++a) leaf.e[e][a][lane] = float(b.edgeNormals[e][a]);
+      leaf.ew[e][lane] = float(dot(b.edgeNormals[e], t.v[e] - origin_));
+      // Corner e lies on edges e and e + 2 (e - 1): the bisector of their outward normals is a positive sum of the
+      // two, so the triangle lies inside its half-plane through the corner too. Where the two normals nearly
+      // cancel (a needle's tip) its direction is ill-conditioned: a zero row.
+      const Vec3 bisector = b.edgeNormals[e] + b.edgeNormals[(e + 2) % 3];
+      if (!(length(bisector) > 0.25)) continue;
+      const Vec3 m = normalize(bisector);
+      for (int a = 0; a < 3; ++a) leaf.e[3 + e][a][lane] = float(m[a]);
+      leaf.ew[3 + e][lane] = float(dot(m, t.v[e] - origin_));
+    }
+    const double k1 = b.slack + double(kRelative);
+    leaf.k1[lane] = floatAbove(k1);
+    leaf.k0[lane] = floatAbove(b.slackAt0 + k1 * magnitude * (1 + 0x1p-20) + double(kAbsolute));
+  }
+  return leaf;
 }
 
 // The squared distance from p to the primitive in `slot`, or infinity when a triangle's plane alone is farther
@@ -156,73 +283,128 @@ double NearestPrimitive::squaredDistanceTo(uint32_t slot, const Vec3& p, double 
   return dot(d, d);
 }
 
-// From the seed's leaf up: at each ancestor, the subtree on the other side is searched (most are pruned by their
-// box alone). Near answers lie in near subtrees, so this tests fewer boxes than a descent from the root.
+// The seed's exact distance is the first bound, tight when the seed is the answer or nearly so, so that the search
+// from the root opens few nodes. Ties still go to the lowest id: the seed's equals are visited and win by id.
 NearestHit NearestPrimitive::nearestFrom(const Vec3& p, int64_t seed) const {
   if (seed < 0 || uint64_t(seed) >= ids_.size()) return nearest(p);
-  // The seed's leaf first, the seed among its primitives: its distance becomes the bound.
   NearestHit best;
-  uint32_t node = leafOf_[slotOf_[size_t(seed)]];
-  visitLeaf(nodes_[node], p, best);
-  while (node != 0) {
-    const uint32_t parent = nodes_[node].parent;
-    search(p, best, node == parent + 1 ? nodes_[parent].first : parent + 1);
-    node = parent;
-  }
+  best.squaredDistance = squaredDistanceTo(slotOf_[size_t(seed)], p, INFINITY);
+  best.primitive = seed;
+  search(p, best);
   return best;
 }
 
 NearestHit NearestPrimitive::nearest(const Vec3& p, double bound2) const {
   NearestHit best;
   best.squaredDistance = bound2;
-  if (!nodes_.empty()) search(p, best, 0);
+  search(p, best);
   if (best.primitive < 0) best.squaredDistance = INFINITY;
   return best;
 }
 
-void NearestPrimitive::visitLeaf(const Node& leaf, const Vec3& p, NearestHit& best) const {
-  for (uint32_t s = leaf.first; s < leaf.first + leaf.count; ++s) {
-    const double d2 = squaredDistanceTo(s, p, best.squaredDistance);
-    const int64_t id = ids_[s];
+// The leaf's triangles' float lower bounds, four at once; the survivors get the double route (which may still prune
+// with the best as it is by then), as the double search gave it to every triangle it reached.
+void NearestPrimitive::visitLeaf(const WideLeaf& leaf, const Vec3& p, const float (&q)[3], float qNorm, bool prune,
+                                 float bestUp, NearestHit& best) const {
+  const __m128 qx = _mm_set1_ps(q[0]), qy = _mm_set1_ps(q[1]), qz = _mm_set1_ps(q[2]), zero = _mm_setzero_ps();
+  const auto row = [&](const float(&v)[3][4], const float* w) {
+    const __m128 d = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_load_ps(v[0]), qx), _mm_mul_ps(_mm_load_ps(v[1]), qy)),
+                                _mm_mul_ps(_mm_load_ps(v[2]), qz));
+    return _mm_sub_ps(d, _mm_load_ps(w));
+  };
+  const __m128 plane = row(leaf.n, leaf.w);
+  const __m128 h = _mm_max_ps(plane, _mm_sub_ps(zero, plane));
+  __m128 s = row(leaf.e[0], leaf.ew[0]);
+  for (int e = 1; e < 6; ++e) s = _mm_max_ps(s, row(leaf.e[e], leaf.ew[e]));
+  const __m128 allowance = _mm_add_ps(_mm_mul_ps(_mm_load_ps(leaf.k1), _mm_set1_ps(qNorm)), _mm_load_ps(leaf.k0));
+  const __m128 hl = _mm_max_ps(_mm_sub_ps(h, allowance), zero), sl = _mm_max_ps(_mm_sub_ps(s, allowance), zero);
+  const __m128 lb2 = _mm_add_ps(_mm_mul_ps(hl, hl), _mm_mul_ps(sl, sl));
+  unsigned open = unsigned(_mm_movemask_ps(_mm_cmple_ps(lb2, _mm_set1_ps(bestUp)))) & ((1u << leaf.count) - 1);
+  if (open == 0) return;
+  // The survivors nearest bound first, each bound checked again against the best so far: the first exact distance
+  // then prunes most of the rest. The answer does not depend on the order (ties go to the lowest id in any order).
+  alignas(16) float bound[4];
+  _mm_store_ps(bound, lb2);
+  int order[4];
+  int count = 0;
+  for (; open != 0; open &= open - 1) {
+    const int lane = __builtin_ctz(open);
+    int i = count++;
+    for (; i > 0 && bound[order[i - 1]] > bound[lane]; --i) order[i] = order[i - 1];
+    order[i] = lane;
+  }
+  for (int k = 0; k < count; ++k) {
+    if (k > 0 && bound[order[k]] > bestUp) break;  // the rest are farther still
+    const uint32_t slot = leaf.first + uint32_t(order[k]);
+    const double d2 = squaredDistanceTo(slot, p, best.squaredDistance);
+    const int64_t id = ids_[slot];
     if (d2 < best.squaredDistance || (d2 == best.squaredDistance && (best.primitive < 0 || id < best.primitive))) {
       best.squaredDistance = d2;
       best.primitive = id;
+      if (prune) bestUp = pruneAbove(d2);
     }
   }
 }
 
-// Lowers `best` to the nearest primitive of the subtree at `root` within it (ties to the lowest id): every subtree
-// whose box is no farther than the best so far is visited, nearer child first.
-void NearestPrimitive::search(const Vec3& p, NearestHit& best, uint32_t root) const {
-  // Depth is about log2(n / kLeafSize) + 1 for a median split: 64 holds any 32-bit count. Each waiting subtree
-  // keeps its box's squared distance, so that it is tested again without recomputing it.
+// Lowers `best` to the nearest primitive within it (ties to the lowest id): every child whose float box bound is
+// no farther than the best so far (pruneAbove) is visited, nearer children first.
+void NearestPrimitive::search(const Vec3& p, NearestHit& best) const {
+  if (wide_.empty()) return;
+  const Vec3 d = p - origin_;
+  const bool prune = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)}) <= kFloatReach;
+  float q[3] = {0, 0, 0};  // without pruning the bounds are computed at the origin and never compared
+  if (prune)
+    for (int a = 0; a < 3; ++a) q[a] = float(d[a]);
+  const float qNorm = std::fabs(q[0]) + std::fabs(q[1]) + std::fabs(q[2]);
+  const __m128 qx = _mm_set1_ps(q[0]), qy = _mm_set1_ps(q[1]), qz = _mm_set1_ps(q[2]), zero = _mm_setzero_ps();
+  const __m128 qn = _mm_set1_ps(qNorm);
+  float bestUp = prune ? pruneAbove(best.squaredDistance) : INFINITY;
+  // Each level pushes at most three more entries than it pops, and the depth is at most 32: 128 hold any tree.
   struct Waiting {
-    uint32_t node;
-    double d2;
+    int32_t node;
+    float d2;
   };
-  std::array<Waiting, 64> stack;
+  std::array<Waiting, 128> stack;
   size_t top = 0;
-  uint32_t current = root;
-  double currentD2 = squaredDistanceToOrientedBox(nodes_[root].box, p);
+  int32_t current = 0;
   for (;;) {
-    if (currentD2 <= best.squaredDistance) {
-      const Node& node = nodes_[current];
-      if (node.count == 0) {
-        const uint32_t a = current + 1, b = node.first;
-        const double da = squaredDistanceToOrientedBox(nodes_[a].box, p),
-                     db = squaredDistanceToOrientedBox(nodes_[b].box, p);
-        const bool aFirst = da <= db;
-        stack[top++] = {aFirst ? b : a, aFirst ? db : da};  // the farther child waits
-        current = aFirst ? a : b;
-        currentD2 = aFirst ? da : db;
-        continue;
-      }
-      visitLeaf(node, p, best);
+    const WideNode& node = wide_[size_t(current)];
+    const __m128 dx = _mm_sub_ps(qx, _mm_load_ps(node.centre[0])), dy = _mm_sub_ps(qy, _mm_load_ps(node.centre[1])),
+                 dz = _mm_sub_ps(qz, _mm_load_ps(node.centre[2]));
+    const __m128 allowance = _mm_add_ps(_mm_mul_ps(_mm_add_ps(qn, _mm_load_ps(node.magnitude)), _mm_set1_ps(kRelative)),
+                                        _mm_set1_ps(kAbsolute));
+    const auto outside = [&](int a) {
+      const __m128 u = _mm_add_ps(
+          _mm_add_ps(_mm_mul_ps(_mm_load_ps(node.axis[a][0]), dx), _mm_mul_ps(_mm_load_ps(node.axis[a][1]), dy)),
+          _mm_mul_ps(_mm_load_ps(node.axis[a][2]), dz));
+      const __m128 e = _mm_sub_ps(_mm_max_ps(u, _mm_sub_ps(zero, u)), _mm_add_ps(_mm_load_ps(node.half[a]), allowance));
+      return _mm_max_ps(e, zero);
+    };
+    const __m128 ex = outside(0), ey = outside(1), ez = outside(2);
+    const __m128 lb2 = _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(ex, ex), _mm_mul_ps(ey, ey)), _mm_mul_ps(ez, ez)),
+                                  _mm_set1_ps(kShrink));
+    alignas(16) float bound[4];
+    _mm_store_ps(bound, lb2);
+    unsigned open = unsigned(_mm_movemask_ps(_mm_cmple_ps(lb2, _mm_set1_ps(bestUp)))) & ((1u << node.count) - 1);
+    // The open children pushed farthest first, so the nearest is popped first.
+    const size_t base = top;
+    for (; open != 0; open &= open - 1) {
+      const int lane = __builtin_ctz(open);
+      size_t i = top++;
+      for (; i > base && stack[i - 1].d2 < bound[lane]; --i) stack[i] = stack[i - 1];
+      stack[i] = {node.child[lane], bound[lane]};
     }
-    if (top == 0) return;
-    --top;
-    current = stack[top].node;
-    currentD2 = stack[top].d2;
+    for (;;) {
+      if (top == 0) return;
+      const Waiting next = stack[--top];
+      if (next.d2 > bestUp) continue;
+      if (next.node >= 0) {
+        current = next.node;
+        break;
+      }
+      visitLeaf(leaves_[size_t(~next.node)], p, q, qNorm, prune, bestUp, best);
+      if (prune) bestUp = pruneAbove(best.squaredDistance);
+    }
   }
 }
 

@@ -1,8 +1,10 @@
 // The bounded primitive nearest to any point (DESIGN.md "Distance and volume": Grid.distance, libvox.sdf): a
-// bounding volume hierarchy over the scene's triangles, spheres and ellipsoids (planes are left out), queried depth
-// first, nearer child first, pruned by proven lower bounds: each node's oriented box, each triangle's plane and edges
-// (triangleLowerBound). Distances are the ones the --sdf band uses (squaredDistanceToTriangle,
-// closestPointOnEllipsoid), so a dense field equals the band bit for bit.
+// bounding volume hierarchy over the scene's triangles, spheres and ellipsoids (planes are left out), four children
+// per node, queried depth first, nearer child first, pruned by proven lower bounds tested four at a time in float
+// (SSE2): each child's axis-aligned box and each leaf triangle's plane and edges (triangleLowerBound), lowered by a
+// rounding allowance that keeps them below the double bounds they stand for (nearest.cpp). Only survivors get the
+// exact double distance the --sdf band uses (squaredDistanceToTriangleWithin, closestPointOnEllipsoid), so a dense
+// field equals the band bit for bit and the answer is the one a double search or brute force gives.
 #pragma once
 
 #include <cstdint>
@@ -22,7 +24,7 @@ struct NearestHit {
 
 class NearestPrimitive {
  public:
-  // Copies what it needs from `scene` (about 270 bytes per primitive, with the nodes). Throws InputError for a singular
+  // Copies what it needs from `scene` (about 350 bytes per primitive, with the nodes). Throws InputError for a singular
   // sphere transform (ellipsoidShape).
   explicit NearestPrimitive(const Scene& scene);
   // The same over the scene scaled into `frame` (vox/core/power_of_two_frame.h): points given to the queries below
@@ -43,33 +45,57 @@ class NearestPrimitive {
 
   size_t primitiveCount() const { return ids_.size(); }
 
-  struct OrientedBox {
-    Vec3 centre;
-    std::array<Vec3, 3> axes;  // orthonormal to rounding
-    Vec3 half;                 // half extents along the axes
-  };
-
  private:
-  struct Node {
-    OrientedBox box;
-    uint32_t first = 0;   // leaf: its first primitive slot; inner: the second child (the first is the next node)
-    uint32_t count = 0;   // primitives of a leaf; 0 for an inner node
-    uint32_t parent = 0;  // the root's is itself
+  // Four children's oriented boxes in float, relative to origin_ (each holds every point of its primitives, about
+  // its float centre along its float axes), as structure of arrays so that one SSE2 pass tests all four. A ray could
+  // test the same boxes (a slab test in each box's axes, on the same lanes, its rounding bounded the same way): the
+  // nodes carry nothing particular to points.
+  struct alignas(16) WideNode {
+    float centre[3][4];
+    float axis[3][3][4];  // axis a's component i; orthonormal to float rounding
+    float half[3][4];
+    float magnitude[4];  // |centre|_1 plus the half extents: the size the rounding allowance scales with
+    int32_t child[4];    // >= 0: a node; < 0: leaf ~child; unused lanes hold a box no point is near, masked out
+    uint32_t count = 0;  // children in use
+  };
+  // A leaf's up to four primitives' lower bounds as float rows relative to origin_: the triangle's plane n.q = w, and
+  // six outward half-planes of its own plane that hold it, e.q = ew: its edges' and, at each corner, the one whose
+  // normal bisects the two edges' (in a corner's region of angle A the bound is then within cos((180 - A) / 4) of
+  // the distance in the plane, where the edges alone give cos((180 - A) / 2)). The allowance k1 |q|_1 + k0 keeps each
+  // below the exact double distance (nearest.cpp). Spheres, ellipsoids, needles and unused lanes hold zero rows: a
+  // bound of 0 that prunes nothing.
+  struct alignas(16) WideLeaf {
+    float n[3][4], w[4];
+    float e[6][3][4], ew[6][4];
+    float k1[4], k0[4];
+    uint32_t first = 0, count = 0;  // slots
+  };
+  struct BinaryNode {
+    uint32_t first = 0;           // leaf: its first slot; inner: the second child (the first is the next node)
+    uint32_t count = 0;           // primitives of a leaf; 0 for an inner node
+    uint32_t begin = 0, end = 0;  // its slots
+  };
+  struct FloatBox {  // one child's lane of a WideNode
+    float centre[3], axis[3][3], half[3];
   };
   double squaredDistanceTo(uint32_t slot, const Vec3& p, double bound2) const;
-  void search(const Vec3& p, NearestHit& best, uint32_t root) const;
-  void visitLeaf(const Node& leaf, const Vec3& p, NearestHit& best) const;
-  uint32_t build(uint32_t begin, uint32_t end, const std::vector<Vec3>& centroids,
-                 std::vector<std::array<uint32_t, 2>>& ranges, uint32_t parent);
-  OrientedBox orientedBounds(uint32_t begin, uint32_t end, const Scene& scene, const std::vector<Box>& boxes) const;
+  void search(const Vec3& p, NearestHit& best) const;
+  void visitLeaf(const WideLeaf& leaf, const Vec3& p, const float (&q)[3], float qNorm, bool prune, float bestUp,
+                 NearestHit& best) const;
+  uint32_t build(uint32_t begin, uint32_t end, const std::vector<Vec3>& centroids, std::vector<BinaryNode>& nodes);
+  int32_t buildWide(uint32_t index, const std::vector<BinaryNode>& nodes, const std::vector<Box>& nodeBoxes,
+                    const std::vector<FloatBox>& floatBoxes);
+  FloatBox orientedBounds(const BinaryNode& node, const Scene& scene, const std::vector<Box>& boxes) const;
+  WideLeaf makeLeaf(const BinaryNode& node) const;
 
-  std::vector<Node> nodes_;
+  std::vector<WideNode> wide_;  // the root first
+  std::vector<WideLeaf> leaves_;
   std::vector<uint32_t> ids_;               // slot -> primitive id, in leaf order
   std::vector<uint32_t> slotOf_;            // primitive id -> slot
-  std::vector<uint32_t> leafOf_;            // slot -> its leaf node
   std::vector<Triangle> triangles_;         // by slot (unused slots of spheres hold nothing useful)
   std::vector<TriangleLowerBound> bounds_;  // by slot, of triangles
   std::vector<EllipsoidShape> shapes_;      // by sphere index
+  Vec3 origin_{0, 0, 0};                    // the centre of the primitives' bounds: the float data's origin
   uint32_t triangleCount_ = 0;
   PowerOfTwoFrame frame_;
 };

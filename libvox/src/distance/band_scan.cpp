@@ -193,8 +193,6 @@ void TileEvaluator::scan(const Primitives& primitives, const int64_t t0[3], cons
   // The tile's x centres, one more past the last (rowLowerBounds reads pairs).
   std::array<double, kTile + 2> xs;
   for (size_t i = 0; i < xs.size(); ++i) xs[i] = centres[0][std::min(size_t(t0[0]) + i, centres[0].size() - 1)];
-  const double x0 = primitives.grid.bounds.lo.x;
-  const double inverseWidth = primitives.grid.dims[0] / (primitives.grid.bounds.hi.x - primitives.grid.bounds.lo.x);
   // Pass 1: each triangle's rows, their cells' lower bounds, and each cell's smallest.
   for (size_t q = 0; q < count; ++q) {
     const uint32_t p = prims[q];
@@ -226,16 +224,13 @@ void TileEvaluator::scan(const Primitives& primitives, const int64_t t0[3], cons
           empty = c.c0 - c.cy * ry - c.cz * rz + std::fabs(c.cx) * rows.dxMax < 0;
         }
         if (empty) continue;
-        // The first and last centre of the row within [ulo, uhi] (relative to a.x): an estimate from the cell
-        // width, then the exact comparisons (the centres less a.x are monotone, so the ends are unique).
-        int64_t i0 =
-            int64_t(std::clamp(std::ceil((a.x + ulo - x0) * inverseWidth - 0.5), double(lo[0]), double(hi[0] + 1)));
-        while (i0 > lo[0] && xs[i0 - 1 - t0[0]] - a.x >= ulo) --i0;
-        while (i0 <= hi[0] && xs[i0 - t0[0]] - a.x < ulo) ++i0;
-        int64_t i1 =
-            int64_t(std::clamp(std::floor((a.x + uhi - x0) * inverseWidth - 0.5), double(i0 - 1), double(hi[0])));
-        while (i1 < hi[0] && xs[i1 + 1 - t0[0]] - a.x <= uhi) ++i1;
-        while (i1 >= i0 && xs[i1 - t0[0]] - a.x > uhi) --i1;
+        // The first and last centre of the row within [ulo, uhi] (relative to a.x), counted without branches.
+        int64_t i0 = lo[0], i1 = hi[0];
+        for (int64_t i = lo[0]; i <= hi[0]; ++i) {
+          const double u = xs[size_t(i - t0[0])] - a.x;
+          i0 += u < ulo;
+          i1 -= u > uhi;
+        }
         if (i0 > i1) continue;
         const size_t first = tileIndex(i0 - t0[0], j - t0[1], k - t0[2]), n = size_t(i1 - i0 + 1);
         runs_.push_back({p, uint16_t(first), uint16_t(n)});

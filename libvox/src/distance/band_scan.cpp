@@ -12,17 +12,19 @@ namespace {
 // interval's accuracy); they only empty a row that no x in the reach box can satisfy.
 constexpr double kMinSlope = 1e-3;
 
+// rowLowerBounds' extra allowance per unit of |p - a|_1 (there).
+constexpr double kReorderSlack = 1e-15;
+
 // The row constraints of a triangle whose centres lie in `box` (the reach box's first and last centres).
 //
 // Why they hold: rowLowerBounds(p) <= reach^2 needs h <= reach (1 + 2^-52) and every edge's computed
-// dot(m_e, p - v_e) - err <= the same, with err <= errMax (1 + 1e-12) over the box. The computed dot products differ
-// from the real n . (p - a) and m_e . (p - v_e) by at most 4 ulps of |p - v|_1 <= paMax, so every centre that can pass
-// has n . (p - a) <= T, -n . (p - a) <= T and m_e . (p - a) <= T + m_e . (v_e - a) with T = (reach + errMax) (1 +
-// 1e-12)
-// + 1e-15 paMax. The rows evaluate these with a few more roundings, each a few ulps of T + paMax (the differences
-// p - a are of doubles within paMax of each other), divided by a slope of at least kMinSlope: the allowance of
-// 1e-9 (T + paMax) added to every c0 covers them a thousand times over (the quotient taken as a product with 1 / cx
-// adds two roundings of at most 1e3 (T + 3 paMax) ulps).
+// dot(m_e, p - v_e) - err <= the same, with err (its rounding included) <= errMax over the box. The computed dot
+// products differ from the real n . (p - a) and m_e . (p - v_e) by at most 4 ulps of |p - v|_1 <= paMax, so every
+// centre that can pass has n . (p - a) <= T, -n . (p - a) <= T and m_e . (p - a) <= T + m_e . (v_e - a), with
+// T = (reach + errMax) (1 + 1e-12) + 1e-15 paMax. The rows evaluate these with a few more roundings, each a few
+// ulps of T + paMax (the differences p - a are of doubles within paMax of each other), divided by a slope of at
+// least kMinSlope (the quotient taken as a product with 1 / cx: two roundings more): the allowance of
+// 1e-9 (T + paMax) added to every c0 covers them a thousand times over.
 RowScan rowScan(const Triangle& t, const TriangleLowerBound& bound, const Box& box, double reach) {
   RowScan rows;
   if (!bound.usable) return rows;
@@ -35,7 +37,7 @@ RowScan rowScan(const Triangle& t, const TriangleLowerBound& bound, const Box& b
     paMax += far;
     errSpan += std::max(std::fabs(box.lo[axis] - a[axis]), std::fabs(box.hi[axis] - a[axis]));
   }
-  const double errMax = (bound.slack * errSpan + bound.slackAt0) * (1 + 1e-10);
+  const double errMax = ((bound.slack + kReorderSlack) * errSpan + bound.slackAt0) * (1 + 1e-10);
   const double T = (reach + errMax) * (1 + 1e-12) + 1e-15 * paMax;
   const double allowance = 1e-9 * (T + paMax);
   const Vec3& n = bound.normal;
@@ -63,10 +65,12 @@ using Double2 = double __attribute__((vector_size(16)));
 Double2 max2(Double2 a, Double2 b) { return a > b ? a : b; }
 Double2 abs2(Double2 a) { return a < 0 ? -a : a; }
 
-// lowerBound at the centres (x[m], y, z), m in [0, n), into out[0, n) (x and out readable and writable one past n):
-// the same bound with each dot product's y and z terms summed once for the row, which moves its rounding by an ulp
-// of terms that the bound's allowance (err, 1e-13 per unit or more) covers a thousand times over; err itself is
-// raised by 1e-12 of itself for the same reason.
+// squaredDistanceToTriangleWithin's lower bound (closest_point.cpp) at the centres (x[m], y, z), m in [0, n), into
+// out[0, n) (x and out readable and writable one past n), with each dot product's y and z terms summed once for the
+// row. That order moves a dot product's rounding by at most 2 ulps of the sum of its terms' magnitudes, at most
+// 2.3e-16 |p - v|_1; the allowance err is raised by 1e-15 per unit of |p - a|_1 to cover it (the part from
+// |v - a| is within slackAt0, 1e-13 of the triangle's size or more), so that the bound still never exceeds the
+// computed distance.
 void rowLowerBounds(const Triangle& t, const TriangleLowerBound& bound, const double* x, size_t n, double y, double z,
                     double* out) {
   if (!bound.usable) {
@@ -77,8 +81,8 @@ void rowLowerBounds(const Triangle& t, const TriangleLowerBound& bound, const do
   const Vec3& nn = bound.normal;
   const Vec3* m = bound.edgeNormals.data();
   const double ry = y - a.y, rz = z - a.z;
-  const double kErr = (bound.slack * (std::fabs(ry) + std::fabs(rz)) + bound.slackAt0) * (1 + 1e-12);
-  const double slack = bound.slack * (1 + 1e-12);
+  const double slack = bound.slack + kReorderSlack;
+  const double kErr = slack * (std::fabs(ry) + std::fabs(rz)) + bound.slackAt0;
   const double kN = nn.y * ry + nn.z * rz;
   const double k0 = m[0].y * ry + m[0].z * rz;
   const double k1 = m[1].y * (y - t.v[1].y) + m[1].z * (z - t.v[1].z);

@@ -27,6 +27,7 @@ namespace {
 struct Candidate {
   uint64_t key;
   double d2;  // squared distance from the cell's centre to its nearest primitive
+  bool operator<(const Candidate& o) const { return key < o.key; }
 };
 
 double smallestCellEdge(const Grid& grid) {
@@ -99,10 +100,6 @@ std::vector<std::vector<Candidate>> bandCandidates(const Grid& grid, const Scene
     band::TileEvaluator& evaluator = evaluators.local();
     std::vector<double> nearest;
     std::vector<uint32_t> tilePrims;
-    // Where each tile's row (k, j) of cells starts in `out`: the slab's key order is then a stitch of the rows
-    // (z, then y, then x), with no sort.
-    constexpr size_t kRows = size_t(kTile) * kTile;
-    std::vector<size_t> rowStarts;
     for (size_t g = slabs[slab][0]; g < slabs[slab][1]; ++g) {
       if (cancelled || overBudget) return;
       const size_t before = out.size();
@@ -117,37 +114,17 @@ std::vector<std::vector<Candidate>> bandCandidates(const Grid& grid, const Scene
       const int64_t end[3] = {std::min<int64_t>(kTile, int64_t(grid.dims[0]) - t0[0]),
                               std::min<int64_t>(kTile, int64_t(grid.dims[1]) - t0[1]),
                               std::min<int64_t>(kTile, int64_t(grid.dims[2]) - t0[2])};
-      for (int64_t k = 0; k < int64_t(kTile); ++k)
-        for (int64_t j = 0; j < int64_t(kTile); ++j) {
-          rowStarts.push_back(out.size());
-          if (k >= end[2] || j >= end[1]) continue;
+      for (int64_t k = 0; k < end[2]; ++k)
+        for (int64_t j = 0; j < end[1]; ++j)
           for (int64_t i = 0; i < end[0]; ++i) {
             const double d2 = nearest[size_t(i + kTile * (j + kTile * k))];
             if (d2 <= reach2) out.push_back({cellKey(grid.dims, t0[0] + i, t0[1] + j, t0[2] + k), d2});
           }
-        }
       if ((emitted += out.size() - before) > maxCells) overBudget = true;
       const uint64_t finished = ++done;
       if (options.progress && !options.progress(0.8 * double(finished) / double(tileCount))) cancelled = true;
     }
-    rowStarts.push_back(out.size());
-    // Tiles come in key order of their corners (y, then x, within the slab's z): for each z, the tiles of one y in
-    // turn, each's row of that z and y, x ascending.
-    const size_t first = slabs[slab][0], count = slabs[slab][1] - first;
-    const auto tileY = [&](size_t t) { return bins[starts[first + t]].tile / tiles[0] % tiles[1]; };
-    std::vector<Candidate> ordered;
-    ordered.reserve(out.size());
-    for (size_t k = 0; k < kTile; ++k)
-      for (size_t begin = 0, end; begin < count; begin = end) {
-        for (end = begin + 1; end < count && tileY(end) == tileY(begin);) ++end;
-        for (size_t j = 0; j < kTile; ++j)
-          for (size_t t = begin; t < end; ++t) {
-            const size_t row = t * kRows + k * kTile + j;  // its cells end where the next row starts
-            ordered.insert(ordered.end(), out.begin() + ptrdiff_t(rowStarts[row]),
-                           out.begin() + ptrdiff_t(rowStarts[row + 1]));
-          }
-      }
-    out.swap(ordered);
+    std::sort(out.begin(), out.end());  // tiles are disjoint: each key comes once
   });
   if (cancelled) fail<Error>("signed distances cancelled");
   if (overBudget)

@@ -80,6 +80,8 @@ class Adversary {
   }
 
   std::mt19937& rng() { return rng_; }
+  const Box& bounds() const { return bounds_; }
+  const std::array<uint32_t, 3>& dims() const { return dims_; }
 
  private:
   std::mt19937 rng_;

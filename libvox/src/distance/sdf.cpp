@@ -11,6 +11,7 @@
 #include "vox/core/error.h"
 #include "vox/core/exact_number.h"
 #include "vox/distance/centre_signs.h"
+#include "distance/band_scan.h"
 #include "vox/voxelize/fill.h"
 
 namespace vox {
@@ -35,34 +36,11 @@ double smallestCellEdge(const Grid& grid) {
   return h;
 }
 
-// Cells are processed in tiles of kTile^3: each primitive is binned into the tiles its box grown by the band's
-// reach meets, and each tile keeps the nearest squared distance of its cells in a small dense array. Memory is then
-// the band's cells and the bins, not one entry per (cell, primitive) pair (which took 0.5 GB for the bunny at 256^3).
-constexpr uint32_t kTile = 16;
-
-struct Reachable {
-  std::array<std::array<int64_t, 2>, 3> cells;  // inclusive cell ranges of the primitive's box grown by the reach
-  bool empty() const { return cells[0][0] > cells[0][1] || cells[1][0] > cells[1][1] || cells[2][0] > cells[2][1]; }
-};
-
-// The squared distance from c to primitive p (triangles first, then the spheres' shapes), or +infinity when the
-// triangle's plane alone is farther than sqrt(bound2): most cells of a triangle's box, and cells a nearer triangle
-// already took.
-struct PrimitiveDistance {
-  const Scene& scene;
-  const std::vector<EllipsoidShape>& shapes;
-  const std::vector<TriangleLowerBound>& bounds;  // of the triangles
-
-  double operator()(size_t p, const Vec3& c, double bound2) const {
-    if (p < scene.triangles.size()) return squaredDistanceToTriangleWithin(scene.triangles[p], bounds[p], c, bound2);
-    const Vec3 d = c - closestPointOnEllipsoid(shapes[p - scene.triangles.size()], c);
-    return dot(d, d);
-  }
-  Box box(size_t p) const {
-    return p < scene.triangles.size() ? triangleBounds(scene.triangles[p])
-                                      : ellipsoidBounds(shapes[p - scene.triangles.size()]);
-  }
-};
+// Cells are processed in tiles of kTile^3 (band_scan.h): each primitive is binned into the tiles its box grown by
+// the band's reach meets, and each tile keeps the nearest squared distance of its cells in a small dense array.
+// Memory is then the band's cells and the bins, not one entry per (cell, primitive) pair (which took 0.5 GB for the
+// bunny at 256^3).
+using band::kTile;
 
 struct TilePrim {
   uint64_t tile;
@@ -72,28 +50,17 @@ struct TilePrim {
 
 // The band's cells with their nearest squared distance, in pieces whose concatenation is in key order.
 std::vector<std::vector<Candidate>> bandCandidates(const Grid& grid, const Scene& scene, double reach,
-                                                   const SdfOptions& options) {
-  const std::array<std::vector<double>, 3> centres = cellCentresByAxis(grid);
-  std::vector<EllipsoidShape> shapes;
-  for (const Sphere& s : scene.spheres) shapes.push_back(ellipsoidShape(s));
-  std::vector<TriangleLowerBound> bounds(scene.triangles.size());
-  for (size_t t = 0; t < bounds.size(); ++t) bounds[t] = triangleLowerBound(scene.triangles[t]);
-  const PrimitiveDistance distance{scene, shapes, bounds};
-  const size_t prims = scene.triangles.size() + shapes.size();
+                                                   const SdfOptions& options, band::Route route) {
+  const band::Primitives primitives(grid, scene, reach);
+  const size_t prims = primitives.count();
   std::array<uint64_t, 3> tiles;
   for (int a = 0; a < 3; ++a) tiles[a] = (grid.dims[a] + kTile - 1) / kTile;
-  const auto reachable = [&](size_t p) {
-    const Box b = distance.box(p);
-    Reachable r;
-    for (int a = 0; a < 3; ++a) r.cells[a] = cellRange(grid.bounds, grid.dims, a, b.lo[a] - reach, b.hi[a] + reach);
-    return r;
-  };
   // Bins.
   tbb::enumerable_thread_specific<std::vector<TilePrim>> binLocals;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, prims, 1024), [&](const tbb::blocked_range<size_t>& r) {
     std::vector<TilePrim>& out = binLocals.local();
     for (size_t p = r.begin(); p < r.end(); ++p) {
-      const Reachable c = reachable(p);
+      const band::Reachable c = primitives.reach(p);
       if (c.empty()) continue;
       for (int64_t tz = c.cells[2][0] / kTile; tz <= c.cells[2][1] / kTile; ++tz)
         for (int64_t ty = c.cells[1][0] / kTile; ty <= c.cells[1][1] / kTile; ++ty)
@@ -127,32 +94,21 @@ std::vector<std::vector<Candidate>> bandCandidates(const Grid& grid, const Scene
   const uint64_t maxCells = options.memoryLimitBytes / (2 * sizeof(Candidate));
   const double reach2 = reach * reach;
   const size_t tileCount = starts.size() - 1;
+  tbb::enumerable_thread_specific<band::TileEvaluator> evaluators;
   tbb::parallel_for(size_t(0), slabs.size(), [&](size_t slab) {
     std::vector<Candidate>& out = pieces[slab];
-    std::vector<double> nearest(size_t(kTile) * kTile * kTile);
+    band::TileEvaluator& evaluator = evaluators.local();
+    std::vector<double> nearest;
+    std::vector<uint32_t> tilePrims;
     for (size_t g = slabs[slab][0]; g < slabs[slab][1]; ++g) {
       if (cancelled || overBudget) return;
       const size_t before = out.size();
       const uint64_t tile = bins[starts[g]].tile;
       const int64_t t0[3] = {int64_t(tile % tiles[0]) * kTile, int64_t(tile / tiles[0] % tiles[1]) * kTile,
                              int64_t(tile / (tiles[0] * tiles[1])) * kTile};
-      std::fill(nearest.begin(), nearest.end(), INFINITY);
-      for (size_t b = starts[g]; b < starts[g + 1]; ++b) {
-        const size_t p = bins[b].prim;
-        const Reachable c = reachable(p);
-        int64_t lo[3], hi[3];
-        for (int a = 0; a < 3; ++a) {
-          lo[a] = std::max(c.cells[a][0], t0[a]);
-          hi[a] = std::min({c.cells[a][1], t0[a] + int64_t(kTile) - 1, int64_t(grid.dims[a]) - 1});
-        }
-        for (int64_t k = lo[2]; k <= hi[2]; ++k)
-          for (int64_t j = lo[1]; j <= hi[1]; ++j)
-            for (int64_t i = lo[0]; i <= hi[0]; ++i) {
-              double& slot = nearest[size_t(i - t0[0]) + kTile * (size_t(j - t0[1]) + kTile * size_t(k - t0[2]))];
-              const double d2 = distance(p, {centres[0][i], centres[1][j], centres[2][k]}, std::min(slot, reach2));
-              if (d2 < slot) slot = d2;
-            }
-      }
+      tilePrims.clear();
+      for (size_t b = starts[g]; b < starts[g + 1]; ++b) tilePrims.push_back(bins[b].prim);
+      evaluator.evaluate(primitives, route, t0, tilePrims.data(), tilePrims.size(), nearest);
       // Only the tile's cells inside the grid: an edge tile's others keep +infinity, which a reach that
       // overflowed to +infinity would once have let through as keys past the grid (issue 45).
       const int64_t end[3] = {std::min<int64_t>(kTile, int64_t(grid.dims[0]) - t0[0]),
@@ -181,13 +137,17 @@ std::vector<std::vector<Candidate>> bandCandidates(const Grid& grid, const Scene
 }  // namespace
 
 SdfBand signedDistanceBand(const Grid& grid, const Scene& scene, const SdfOptions& options) {
+  return band::signedDistanceBand(grid, scene, options, band::Route::kScan);
+}
+
+SdfBand band::signedDistanceBand(const Grid& grid, const Scene& scene, const SdfOptions& options, Route route) {
   checkSdfHalfWidth(options.halfWidth, "--sdf");
   const double reach = options.halfWidth * smallestCellEdge(grid);
   // Squared distances are compared with reach^2: an overflow would take every cell (storeSignedDistances works in
   // a frame where it cannot).
   if (!std::isfinite(reach * reach))
     fail<InputError>("--sdf: the band's reach ", reach, " squared overflows; scale the scene nearer 1");
-  std::vector<std::vector<Candidate>> pieces = bandCandidates(grid, scene, reach, options);
+  std::vector<std::vector<Candidate>> pieces = bandCandidates(grid, scene, reach, options, route);
   size_t total = 0;
   for (const auto& piece : pieces) total += piece.size();
   SdfBand band;

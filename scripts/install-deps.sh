@@ -26,8 +26,10 @@ list=0
 for arg in "$@"; do
   case $arg in
     --list) list=1 ;;
-    # bench/python_bench.py compares with Open3D (Debian's 0.16) and draws its bars with tqdm.
-    --bench) packages+=(libbenchmark-dev libembree-dev python3-open3d python3-tqdm python3-matplotlib) ;;
+    # bench/python_bench.py compares with Open3D (Debian's 0.16) and draws its bars with tqdm; bench/surface_bench.py
+    # with scikit-image's marching cubes and OpenVDB's meshToLevelSet + volumeToMesh (pyopenvdb).
+    --bench) packages+=(libbenchmark-dev libembree-dev python3-open3d python3-tqdm python3-matplotlib python3-skimage
+                        python3-openvdb) ;;
     --meshlab) packages+=(meshlab xvfb xauth) ;;
     # Real clients of exported meshes (tests/cli/export_*.sh); numpy for Blender's glTF importer.
     # python3-openvdb (pyopenvdb) reads exported .vdb files back (tests/cli/export_voxel_formats.sh).

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 #include <rapidcheck.h>
+#include <tbb/task_arena.h>
 #include <rapidcheck/gtest.h>
 
 #include <algorithm>
@@ -208,6 +209,27 @@ TEST(LevelSurface, OpenBunny) {
   const Scene s = loadScene(seed("meshes/bun_zipper.ply"));
   const Grid g = bandGrid(s, withCubicCells(s, resolution(kSanitized ? 24 : 64)));
   checkedSurface(s, g, 0, false);
+}
+
+// Layers of cubes are marched in parallel and the vertices numbered plane by plane: one thread and four give the
+// same mesh, bit for bit (vertices in edge order, faces in cube order), on an open mesh and at a level != 0.
+TEST(LevelSurface, SameMeshOnOneThreadAndOnFour) {
+  const Scene open = loadScene(seed("meshes/bun_zipper.ply"));
+  const Scene closed = loadScene(seed("6837/scenes/bunny_5k.obj"));
+  const Grid a = bandGrid(open, withCubicCells(open, resolution(kSanitized ? 20 : 48)));
+  const Grid b = bandGrid(closed, withCubicCells(closed, resolution(kSanitized ? 20 : 40)), 4);
+  for (const auto& [grid, level] :
+       {std::pair<const Grid*, double>{&a, 0.0}, {&b, -0.3 * (b.bounds.hi.x - b.bounds.lo.x) / b.dims[0]}}) {
+    VoxelMesh one, four;
+    tbb::task_arena(1).execute([&] { one = extractLevelSurface(*grid, level); });
+    tbb::task_arena(4).execute([&] { four = extractLevelSurface(*grid, level); });
+    ASSERT_GT(one.faceCount(), 0u);
+    EXPECT_EQ(one.faceVertices, four.faceVertices);
+    EXPECT_EQ(one.faceStart, four.faceStart);
+    ASSERT_EQ(one.positions.size(), four.positions.size());
+    for (size_t v = 0; v < one.positions.size(); ++v)
+      for (int axis = 0; axis < 3; ++axis) ASSERT_EQ(one.positions[v][axis], four.positions[v][axis]) << v;
+  }
 }
 
 TEST(LevelSurface, FractionsVolumeOfClosedMeshes) {

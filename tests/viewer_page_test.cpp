@@ -4,7 +4,8 @@
 // giving back the grid's keys, counts and first ids; the surface's triangles being the merged mesh's, placed on
 // the lattice, one colour per vertex; widths that follow the data (u8/u16/u32 counts and palette indices, u16/u32
 // lattice); the solid runs, the scene's primitives; the signed-distance band and the volume fractions (issue 38),
-// whose absence leaves the layout as it was; the HTML around the data.
+// whose absence leaves the layout as it was; the level surface of the band (issue 47, flag bit 10) being
+// extractLevelSurface's; the HTML around the data.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,6 +18,8 @@
 
 #include "test_util.h"
 #include "vox/core/error.h"
+#include "vox/distance/sdf.h"
+#include "vox/export/level_surface.h"
 #include "vox/export/viewer_page.h"
 #include "vox/export/voxel_mesh.h"
 #include "vox/voxelize/fill.h"
@@ -78,6 +81,10 @@ struct Decoded {
   double halfWidth = 0;
   std::vector<uint64_t> bandRowKeys, bandRowStart, bandI;
   std::vector<float> distances, fractions;
+  // Flag bit 10: the level surface (its counts lead its arrays).
+  uint32_t levelVertexCount = 0, levelTriangleCount = 0;
+  std::vector<float> levelVertices;
+  std::vector<uint32_t> levelTriangles;
   size_t fieldsAt = 0;  // where the fields' arrays start (the end of the layout of a grid without them)
 };
 
@@ -147,6 +154,13 @@ Decoded decode(const std::string& bytes) {
     for (size_t b = 240; b < kViewerHeaderBytes; ++b) EXPECT_EQ(bytes[b], '\0') << "header byte " << b;
   }
   if (d.flags & 512) d.fractions = l.takeAs<float>(d.occupied);
+  if (d.flags & 1024) {
+    const auto counts = l.takeAs<uint32_t>(2);
+    d.levelVertexCount = counts[0];
+    d.levelTriangleCount = counts[1];
+    d.levelVertices = l.takeAs<float>(3 * size_t(d.levelVertexCount));
+    d.levelTriangles = l.takeAs<uint32_t>(3 * size_t(d.levelTriangleCount));
+  }
   EXPECT_EQ(l.at, bytes.size()) << "the layout ends where its last array does";
   return d;
 }
@@ -471,7 +485,7 @@ TEST(ViewerPage, DistancesAndFractionsFollowTheArrays) {
   // Without the fields the layout is the one above up to where they start, with flags bits 8-9 and bytes 240-255
   // cleared: pages of grids without them did not change.
   std::string stripped = encodeViewerData(grid, scene, {}).substr(0, d.fieldsAt);
-  const uint32_t flags = d.flags & ~768u;
+  const uint32_t flags = d.flags & ~1792u;
   std::memcpy(stripped.data() + 12, &flags, 4);
   std::fill(stripped.begin() + 240, stripped.begin() + kViewerHeaderBytes, '\0');
   EXPECT_EQ(stripped, plain);
@@ -492,6 +506,38 @@ TEST(ViewerPage, DistancesAndFractionsFollowTheArrays) {
   const Decoded f = decode(encodeViewerData(onlyFractions, scene, {}));
   EXPECT_EQ(f.flags & 768, 512u);
   EXPECT_EQ(f.fractions.size(), grid.cellKeys.size());
+}
+
+// The level surface d = 0 (flag bit 10) is extractLevelSurface's, positions as float relative to the bounds'
+// centre; a band too narrow for level 0 (narrower than a cell's diagonal) and a grid without a band have none.
+TEST(ViewerPage, LevelSurfaceFollowsTheFields) {
+  Grid grid;
+  const Scene scene = voxelizedBox(grid, {9, 7, 5}, false);
+  SdfOptions options;
+  options.halfWidth = 3;
+  storeSignedDistances(grid, scene, options, false);
+  ASSERT_GE(largestSurfaceLevel(grid), 0);
+  const VoxelMesh level = extractLevelSurface(grid, 0);
+  ASSERT_GT(level.faceCount(), 0u);
+  ViewerDataStats stats;
+  const Decoded d = decode(encodeViewerData(grid, scene, {}, &stats));
+  EXPECT_EQ(d.flags & 1792, 1792u & ~512u);
+  ASSERT_EQ(d.levelVertexCount, level.vertexCount());
+  ASSERT_EQ(d.levelTriangleCount, level.faceCount());
+  EXPECT_EQ(stats.levelTriangles, level.faceCount());
+  const Vec3 centre = (grid.bounds.lo + grid.bounds.hi) * 0.5;
+  for (size_t v = 0; v < level.vertexCount(); ++v)
+    for (int a = 0; a < 3; ++a)
+      ASSERT_EQ(d.levelVertices[3 * v + size_t(a)], float(level.positions[v][a] - centre[a])) << v;
+  EXPECT_EQ(d.levelTriangles, level.faceVertices);
+
+  Grid narrow = grid;
+  narrow.sdfHalfWidth = 1;  // 1 cell < the diagonal: --surface refuses level 0, the page has no surface
+  ASSERT_LT(largestSurfaceLevel(narrow), 0);
+  EXPECT_EQ(decode(encodeViewerData(narrow, scene, {})).flags & 1024, 0u);
+  Grid plain;
+  const Scene plainScene = voxelizedBox(plain, {9, 7, 5}, false);
+  EXPECT_EQ(decode(encodeViewerData(plain, plainScene, {})).flags & 1792, 0u);
 }
 
 TEST(ViewerPage, FieldsThatDoNotFitTheGridAreRefused) {

@@ -7,7 +7,9 @@
 #    no edge with more than two faces, and colours (PLY: a colour attribute; OBJ: one material per colour);
 #  - glTF: colours (one material per colour) and all triangles; closed when it has a single colour. Blender's
 #    glTF importer gives every primitive its own vertices, so a glTF of several colours opens along the colour
-#    seams in Blender (boundary edges are printed, not checked; docs/vox-export.md, "Meshes").
+#    seams in Blender (boundary edges are printed, not checked; docs/vox-export.md, "Meshes");
+#  - level surfaces (--surface, issue 47) of a course bunny and the 69k open bunny as .glb .ply .obj .stl: Blender's
+#    vertex and triangle counts are the surface's, zero boundary edges, no edge with more than two faces.
 # Debian 12's Blender glTF add-on needs `numpy.bool = bool` (blender_import.py sets it): its bug with numpy 1.24,
 # not ours. One Blender run imports every file (Blender starts in about 2 s). Skips (exit 0) when blender is
 # missing; CI installs it (scripts/install-deps.sh --clients).
@@ -63,6 +65,26 @@ for grid in $grids; do
   done
 done
 
+# Level surfaces (vox-export --surface, issue 47), one Blender run with the rest: the course's closed bunny and the
+# 69k open bunny as .glb .ply .obj .stl, each with the surface's own counts ("surface" in the colour column).
+surfaces="bunny_1k:$seed/bunny_1k.obj:24"
+[ -z "$sanitized" ] && [ -f "$seed/bunny_5k.obj" ] && surfaces="bunny_5k:$seed/bunny_5k.obj:48"
+open=${VOX_SEED_DIR:-$src/data}/meshes/bun_zipper.ply
+[ -z "$sanitized" ] && [ -f "$open" ] && surfaces="$surfaces bun_zipper:$open:64"
+for case in $surfaces; do
+  IFS=: read -r name scene res <<<"$case"
+  [ -f "$scene" ] || continue
+  "$build/vox-voxelize" "$scene" -o "$tmp/$name.vgrid" --res "$res" --sdf --quiet || { fail "voxelize $name"; continue; }
+  for ext in glb ply obj stl; do
+    mesh="$tmp/${name}_surface.$ext"
+    "$build/vox-export" "$tmp/$name.vgrid" -o "$mesh" --surface --stats --quiet 2>"$tmp/stats" ||
+      { fail "surface $mesh"; continue; }
+    vertices=$(sed -n 's/^vertices: //p' "$tmp/stats") count=$(sed -n 's/^faces: //p' "$tmp/stats")
+    echo "$mesh $vertices $count $count surface" >>"$tmp/expect"
+    files+=("$mesh")
+  done
+done
+
 script=$src/tests/clients/blender_import.py
 (cd "$tmp" && timeout 600 blender -b --factory-startup --python "$script" -- "${files[@]}") >"$tmp/blender.log" 2>&1
 checked=0
@@ -81,6 +103,14 @@ while read -r mesh vertices faces triangles color; do
   checked=$((checked + 1))
   echo "$name: $(echo "$line" | cut -d' ' -f3-)"
   [ "$(val nonmanifold)" = 0 ] || fail "$name: $(val nonmanifold) edges with more than two faces"
+  if [ "$color" = surface ]; then
+    # Every importer (STL's too: it merges equal positions) must give the surface's vertices and triangles, and
+    # the surface stays closed in Blender: no boundary edge, no edge with more than two faces (checked above).
+    [ "$(val verts)" = "$vertices" ] || fail "$name: Blender has $(val verts) vertices, the surface $vertices"
+    [ "$(val faces)" = "$faces" ] || fail "$name: Blender has $(val faces) faces, the surface $faces"
+    [ "$(val boundary)" = 0 ] || fail "$name: $(val boundary) boundary edges in Blender"
+    continue
+  fi
   case $name in
     *.ply | *.obj)
       [ "$(val verts)" = "$vertices" ] || fail "$name: Blender has $(val verts) vertices, the mesh $vertices"
@@ -102,4 +132,4 @@ while read -r mesh vertices faces triangles color; do
 done <"$tmp/expect"
 echo "export_blender: $checked files imported by $(blender --version 2>/dev/null | head -1)"
 if [ "$failures" -gt 0 ]; then echo "$failures failure(s)"; exit 1; fi
-echo "export_blender: Blender imports PLY and OBJ closed with their colours, glTF with its colours"
+echo "export_blender: Blender imports PLY and OBJ closed with their colours, glTF with its colours, level surfaces closed with their counts"

@@ -190,8 +190,8 @@ const cube = join(dir, 'cube.vgrid');
 
 {
   // The same cube without distances (the same file name, so the same title): the page's data is the --sdf page's
-  // without the fields (its flag bits 8 and 9, header bytes 240-255 and the arrays after the spheres), and the page
-  // offers no field.
+  // without the fields (its flag bits 8 to 10, header bytes 240-255 and the arrays after the spheres: the band's
+  // and the level surface's), and the page offers no field.
   const plain = join(dir, 'plain', 'cube.vgrid');
   mkdirSync(join(dir, 'plain'));
   tool('vox-voxelize', join(source, 'tests', 'data', 'unit_cube.obj'), '-o', plain, '--grid', '13', '13', '13',
@@ -200,8 +200,8 @@ const cube = join(dir, 'cube.vgrid');
   const before = await layoutFromElements(pageData(`${plain}.html`));
   const withSdf = (await layoutFromElements(pageData(`${cube}.html`))).slice();
   const flags = new DataView(withSdf.buffer).getUint32(12, true);
-  check((flags & 0x300) === 0x100, 'the --sdf page sets flag bit 8 only');
-  new DataView(withSdf.buffer).setUint32(12, flags & ~0x300, true);
+  check((flags & 0x700) === 0x500, 'the --sdf page sets flag bits 8 and 10 (distances and their surface) only');
+  new DataView(withSdf.buffer).setUint32(12, flags & ~0x700, true);
   withSdf.fill(0, HEADER_BYTES - 16, HEADER_BYTES);
   const prefix = withSdf.subarray(0, before.length);
   check(

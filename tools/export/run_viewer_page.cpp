@@ -33,10 +33,12 @@ int runViewerPage(const Options& opt) {
   bar.finish();
   if (opt.stats)
     std::fprintf(stderr,
-                 "voxels: %llu\nsurface_vertices: %llu\nsurface_triangles: %llu\nstored_ids: %llu\ndata_bytes: %llu\n"
-                 "output_bytes: %llu\ntotal_seconds: %.6f\n",
+                 "voxels: %llu\nsurface_vertices: %llu\nsurface_triangles: %llu\nlevel_surface_vertices: %llu\n"
+                 "level_surface_triangles: %llu\nstored_ids: %llu\ndata_bytes: %llu\noutput_bytes: %llu\n"
+                 "total_seconds: %.6f\n",
                  (unsigned long long)stats.voxels, (unsigned long long)stats.surfaceVertices,
-                 (unsigned long long)stats.surfaceTriangles, (unsigned long long)stats.storedIds,
+                 (unsigned long long)stats.surfaceTriangles, (unsigned long long)stats.levelVertices,
+                 (unsigned long long)stats.levelTriangles, (unsigned long long)stats.storedIds,
                  (unsigned long long)stats.dataBytes, (unsigned long long)stats.pageBytes, secondsSince(start));
   return kExitOk;
 }

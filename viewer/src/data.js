@@ -110,6 +110,10 @@ export function decodeViewerData(bytes) {
     // Flags bits 8 and 9: the grid's signed-distance band and volume fractions (issue 38), arrays at the end.
     hasDistances: (flags & 256) !== 0,
     hasFractions: (flags & 512) !== 0,
+    // Flag bit 10: the level surface d = 0 of the band (issue 47, vox-export --surface), arrays at the very end.
+    hasLevelSurface: (flags & 1024) !== 0,
+    levelVertexCount: 0,
+    levelTriangleCount: 0,
     bandCount: 0,
     bandRowCount: 0,
     halfWidth: 0,
@@ -151,6 +155,17 @@ export function decodeViewerData(bytes) {
   d.bandI = d.hasDistances ? take(Coord, d.bandCount) : null;
   d.distances = d.hasDistances ? take(Float32Array, d.bandCount) : null;
   d.fractions = d.hasFractions ? take(Float32Array, d.occupiedCount) : null;
+  d.levelVertices = null;
+  d.levelTriangles = null;
+  if (d.hasLevelSurface) {
+    const counts = take(Uint32Array, 2);
+    d.levelVertexCount = counts[0];
+    d.levelTriangleCount = counts[1];
+    d.levelVertices = take(Float32Array, 3 * d.levelVertexCount);
+    d.levelTriangles = take(Uint32Array, 3 * d.levelTriangleCount);
+    for (let i = 0; i < d.levelTriangles.length; ++i)
+      if (d.levelTriangles[i] >= d.levelVertexCount) throw new LayoutError('viewer data: a level-surface index out of range');
+  }
   if (at !== bytes.length) throw new LayoutError(`viewer data: ${bytes.length} bytes, the layout ends at ${at}`);
 
   // Where each cell's stored ids start (min(count, idsPerCell) each, in cell order).

@@ -142,6 +142,19 @@ async function start() {
     sceneBox.union(new THREE.Box3().setFromObject(mesh));
     overlay.add(mesh);
   }
+  // The level surface d = 0 of the band (vox-export --surface), when the page has one: shown beside the voxels,
+  // switched on in the panel; shaded by its normals (the page has no lights), not cut by the slice plane.
+  let levelMesh = null;
+  if (data.hasLevelSurface && data.levelTriangleCount > 0) {
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.BufferAttribute(data.levelVertices, 3));
+    g.setIndex(new THREE.BufferAttribute(data.levelTriangles, 1));
+    g.computeVertexNormals();
+    levelMesh = new THREE.Mesh(g, new THREE.MeshNormalMaterial());
+    levelMesh.visible = false;
+    scene.add(levelMesh);
+  }
+  api.levelMesh = levelMesh;
   const pickBox = new THREE.LineSegments(
     new THREE.EdgesGeometry(new THREE.BoxGeometry(1, 1, 1)),
     new THREE.LineBasicMaterial({ color: 0xff2a00, depthTest: false }),
@@ -311,6 +324,7 @@ async function start() {
       if (!timings.firstRender) timings.firstRender = performance.now();
       if (!lod.coarse && !timings.firstFullRender) timings.firstFullRender = performance.now();
       renderer.render(scene, camera);
+      api.drawnTriangles = renderer.info.render.triangles;  // for tests: what the last frame drew
       ++frames;
       api.frames = frames;
       if (!api.ready) {
@@ -441,6 +455,7 @@ async function start() {
       else if (what === 'bounds') boundsLines.visible = on;
       else if (what === 'lines') surface.uniforms.uLines.value = on ? 1 : 0;
       else if (what === 'voxels') voxels.visible = on;
+      else if (what === 'level' && levelMesh) levelMesh.visible = on;
       render();
     },
     resetCamera: () => {

@@ -99,7 +99,8 @@ export function buildPanel(data, cells, actions) {
         (data.solidCount ? ` · ${fmt(data.solidCount)} solid` : '') +
         ` · ${prims} · colour: ${data.colorMode}` +
         (data.hasDistances ? ` · signed distances: ${fmt(data.bandCount)} band cells` : '') +
-        (data.hasFractions ? ' · volume fractions' : ''),
+        (data.hasFractions ? ' · volume fractions' : '') +
+        (data.hasLevelSurface ? ` · surface d = 0: ${fmt(data.levelTriangleCount)} triangles` : ''),
     }),
   );
 
@@ -150,6 +151,10 @@ export function buildPanel(data, cells, actions) {
       checkbox('vox-show-triangles', 'triangles', false, (on) => actions.toggle('triangles', on)),
       checkbox('vox-show-bounds', 'bounds', true, (on) => actions.toggle('bounds', on)),
       checkbox('vox-show-lines', 'cell lines', false, (on) => actions.toggle('lines', on)),
+      // The level surface d = 0 (vox-export --surface), on pages of grids with distances.
+      ...(data.hasLevelSurface && data.levelTriangleCount > 0
+        ? [checkbox('vox-show-level', 'surface (d = 0)', false, (on) => actions.toggle('level', on))]
+        : []),
     ),
   );
   const reset = el('button', { id: 'vox-reset', type: 'button', text: 'file camera' });

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "vox/core/error.h"
+#include "voxel_surface.h"
 
 namespace vox {
 namespace level_surface_impl {
@@ -160,6 +161,36 @@ class Band {
   uint64_t rowBegin(uint64_t row) const { return rowStart_[row]; }
   uint64_t rowEnd(uint64_t row) const { return rowStart_[row + 1]; }
 
+  // at(i, j, k) for one row (j, k) and i never decreasing from call to call: a position that only moves forward
+  // instead of a binary search per corner (the same answers: the first band cell at or after i, as lower_bound).
+  class RowCursor {
+   public:
+    RowCursor(const Band& band, int64_t j, int64_t k) : band_(band) {
+      const auto& n = band.n_;
+      if (j < 0 || k < 0 || j >= n[1] || k >= n[2]) return;  // beyond the grid: every corner BeyondGrid
+      inGrid_ = true;
+      row_ = uint64_t(j) + uint64_t(n[1]) * uint64_t(k);
+      pos_ = begin_ = band.rowStart_[row_];
+      end_ = band.rowStart_[row_ + 1];
+    }
+    Corner at(int64_t i) {
+      const auto& n = band_.n_;
+      if (!inGrid_ || i < 0 || i >= n[0]) return {};
+      if (begin_ == end_) return {Kind::OutsideBand, band_.rowInside_[row_] != 0, 0};
+      const uint64_t key = uint64_t(i) + uint64_t(n[0]) * row_;
+      const auto& keys = band_.grid_.sdfKeys;
+      while (pos_ < end_ && keys[pos_] < key) ++pos_;
+      if (pos_ < end_ && keys[pos_] == key) return band_.band(pos_);
+      const uint64_t nearest = pos_ == begin_ ? pos_ : pos_ - 1;
+      return {Kind::OutsideBand, band_.grid_.sdfValues[nearest] < band_.level_, 0};
+    }
+
+   private:
+    const Band& band_;
+    bool inGrid_ = false;
+    uint64_t row_ = 0, begin_ = 0, end_ = 0, pos_ = 0;
+  };
+
  private:
   // Rows without band cells take the side of a neighbouring row (j +- 1 or k +- 1), breadth first from the rows
   // with band cells; with no band at all everything is outside.
@@ -267,62 +298,63 @@ class Marcher {
   std::array<uint32_t, 3> n_;
 };
 
-std::array<Corner, 8> cornersOf(const Band& band, const std::array<int64_t, 3>& m) {
-  std::array<Corner, 8> c;
-  for (int v = 0; v < 8; ++v) c[v] = band.at(m[0] + (v & 1), m[1] + ((v >> 1) & 1), m[2] + ((v >> 2) & 1));
-  return c;
-}
-
-// Every cube of the padded lattice whose corners are not all on one side, row by row: the cubes with lowest corner
-// (i, j, k), i from -1 to n_x - 1, between the rows (j, k), (j + 1, k), (j, k + 1), (j + 1, k + 1), j and k from -1.
-// Cubes touching a band cell or the grid's x ends are looked at one by one; between them every row is one run of
-// cells outside the band, with one side, so a stretch of cubes is skipped at once when the four sides agree.
-void marchAllCubes(const Grid& grid, const Band& band, double level, Marcher& out, LevelSurfaceStats& stats,
-                   const std::function<bool(double)>& progress) {
+// The cubes of one layer k of the padded lattice (lowest corners (i, j, k), i from -1 to n_x - 1 and j from -1 to
+// n_y - 1) whose corners are not all on one side, row by row: the cubes between the rows (j, k), (j + 1, k),
+// (j, k + 1), (j + 1, k + 1). Cubes touching a band cell or the grid's x ends are looked at one by one; between them
+// every row is one run of cells outside the band, with one side, so a stretch of cubes is skipped at once when the
+// four sides agree. Layers are independent: each is marched by one thread into its own Marcher, in cube order.
+void marchLayer(const Grid& grid, const Band& band, double level, int64_t k, Marcher& out, LevelSurfaceStats& stats) {
   const auto& n = grid.dims;
   const int64_t nx = n[0], ny = n[1], nz = n[2];
   std::vector<int64_t> candidates;
-  const auto visit = [&](const std::array<int64_t, 3>& m) {
-    const std::array<Corner, 8> c = cornersOf(band, m);
-    int inside = 0;
-    for (const Corner& x : c) inside += x.inside;
-    if (inside == 0 || inside == 8) return;
-    ++stats.cubes;
-    const size_t before = out.triangles.size();
-    out.march(m, c, grid, level);
-    for (const Corner& x : c)
-      if (x.kind == Kind::BeyondGrid) {
-        stats.capTriangles += out.triangles.size() - before;
-        break;
-      }
-  };
-  for (int64_t k = -1; k < nz; ++k) {
-    if (progress && !progress(0.8 * double(k + 1) / double(nz + 1))) throw Error("surface cancelled");
-    for (int64_t j = -1; j < ny; ++j) {
-      candidates.assign({-1, nx - 1});
-      for (int64_t dk = 0; dk < 2; ++dk)
-        for (int64_t dj = 0; dj < 2; ++dj) {
-          if (j + dj < 0 || j + dj >= ny || k + dk < 0 || k + dk >= nz) continue;
-          const uint64_t row = uint64_t(j + dj) + uint64_t(ny) * uint64_t(k + dk);
-          for (uint64_t b = band.rowBegin(row); b < band.rowEnd(row); ++b) {
-            const int64_t i = int64_t(grid.sdfKeys[b] % uint64_t(nx));
-            candidates.push_back(i - 1);
-            if (i < nx - 1) candidates.push_back(i);
-          }
+  std::vector<size_t> runEnd;  // candidates[runEnd[r - 1], runEnd[r]) ascend; the first run is {-1, nx - 1}
+  for (int64_t j = -1; j < ny; ++j) {
+    // Rows (j, k), (j + 1, k), (j, k + 1), (j + 1, k + 1): cube corner v lies on row (v >> 1) & 3.
+    std::array<Band::RowCursor, 4> rows{Band::RowCursor(band, j, k), Band::RowCursor(band, j + 1, k),
+                                        Band::RowCursor(band, j, k + 1), Band::RowCursor(band, j + 1, k + 1)};
+    const auto visit = [&](int64_t i) {
+      std::array<Corner, 8> c;
+      for (int v = 0; v < 8; ++v) c[size_t(v)] = rows[size_t((v >> 1) & 3)].at(i + (v & 1));
+      int inside = 0;
+      for (const Corner& x : c) inside += x.inside;
+      if (inside == 0 || inside == 8) return;
+      ++stats.cubes;
+      const size_t before = out.triangles.size();
+      out.march({i, j, k}, c, grid, level);
+      for (const Corner& x : c)
+        if (x.kind == Kind::BeyondGrid) {
+          stats.capTriangles += out.triangles.size() - before;
+          break;
         }
-      std::sort(candidates.begin(), candidates.end());
-      candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
-      int64_t next = -1;  // the first cube not yet looked at
-      for (const int64_t c : candidates) {
-        if (c > next) {  // cubes next .. c - 1: every row one run outside the band
-          bool side[4];
-          for (int r = 0; r < 4; ++r) side[r] = band.at(next, j + (r & 1), k + (r >> 1)).inside;
-          if (!(side[0] == side[1] && side[1] == side[2] && side[2] == side[3]))
-            for (int64_t i = next; i < c; ++i) visit({i, j, k});
+    };
+    candidates.assign({-1, nx - 1});
+    runEnd.assign({2});
+    for (int64_t dk = 0; dk < 2; ++dk)
+      for (int64_t dj = 0; dj < 2; ++dj) {
+        if (j + dj < 0 || j + dj >= ny || k + dk < 0 || k + dk >= nz) continue;
+        const uint64_t row = uint64_t(j + dj) + uint64_t(ny) * uint64_t(k + dk);
+        for (uint64_t b = band.rowBegin(row); b < band.rowEnd(row); ++b) {
+          const int64_t i = int64_t(grid.sdfKeys[b] % uint64_t(nx));
+          candidates.push_back(i - 1);
+          if (i < nx - 1) candidates.push_back(i);
         }
-        visit({c, j, k});
-        next = c + 1;
+        runEnd.push_back(candidates.size());
       }
+    // Each row's candidates ascend (its band cells do): merge the four runs instead of sorting.
+    for (size_t r = 1; r < runEnd.size(); ++r)
+      std::inplace_merge(candidates.begin(), candidates.begin() + ptrdiff_t(runEnd[r - 1]),
+                         candidates.begin() + ptrdiff_t(runEnd[r]));
+    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+    int64_t next = -1;  // the first cube not yet looked at
+    for (const int64_t c : candidates) {
+      if (c > next) {  // cubes next .. c - 1: every row one run outside the band
+        bool side[4];
+        for (int r = 0; r < 4; ++r) side[r] = rows[size_t(r)].at(next).inside;
+        if (!(side[0] == side[1] && side[1] == side[2] && side[2] == side[3]))
+          for (int64_t i = next; i < c; ++i) visit(i);
+      }
+      visit(c);
+      next = c + 1;
     }
   }
 }
@@ -399,41 +431,93 @@ VoxelMesh extractLevelSurface(const Grid& grid, double level, LevelSurfaceStats*
 
   LevelSurfaceStats stats;
   const Band band(grid, level);
-  Marcher marcher(grid);
-  marchAllCubes(grid, band, level, marcher, stats, progress);
-  if (progress && !progress(0.85)) throw Error("surface cancelled");
+  voxel_surface::ExportProgress report(progress, "surface");
+  report.phase(0, 0.8);
+  // Layers of cubes (padded z from 0 to n_z), each marched on its own into its own list: concatenated in layer order
+  // they are the cubes in the serial order, so the output does not depend on threads.
+  const size_t layers = size_t(grid.dims[2]) + 1;
+  std::vector<Marcher> marched(layers, Marcher(grid));
+  std::vector<LevelSurfaceStats> layerStats(layers);
+  report.parallelFor(layers, [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t l = r.begin(); l != r.end(); ++l)
+      marchLayer(grid, band, level, int64_t(l) - 1, marched[l], layerStats[l]);
+  });
+  std::vector<size_t> firstTriangle(layers + 1, 0);
+  for (size_t l = 0; l < layers; ++l) {
+    stats.cubes += layerStats[l].cubes;
+    stats.capTriangles += layerStats[l].capTriangles;
+    firstTriangle[l + 1] = firstTriangle[l] + marched[l].triangles.size();
+  }
+  const size_t triangleCount = firstTriangle[layers];
 
-  // One vertex per lattice edge, in edge order.
-  std::vector<EdgeId> edges;
-  edges.reserve(marcher.triangles.size() * 3);
-  for (const auto& t : marcher.triangles) edges.insert(edges.end(), t.begin(), t.end());
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-  if (edges.size() > std::numeric_limits<uint32_t>::max() ||
-      marcher.triangles.size() > std::numeric_limits<uint32_t>::max() / 3)
-    fail<LimitError>("surface: ", edges.size(), " vertices and ", marcher.triangles.size(),
+  if (triangleCount > std::numeric_limits<uint32_t>::max() / 3)
+    fail<LimitError>("surface: ", triangleCount, " triangles, more than a mesh of 32-bit indices holds");
+
+  // One vertex per lattice edge, in edge order. An edge's lower end lies in the padded z plane of its cube's layer
+  // or the next one, and edge order is plane by plane (the plane is the major part of the point's index): each
+  // plane's triangle corners, from the two layers touching it, sorted by edge on their own and laid one plane after
+  // the other give the edges in order, and each corner its vertex, with no search.
+  report.phase(0.8, 0.9);
+  const uint64_t planeSize = (uint64_t(grid.dims[0]) + 2) * (uint64_t(grid.dims[1]) + 2);
+  const size_t planes = layers + 1;
+  struct CornerRef {
+    uint64_t key;     // (point within the plane) * 8 + direction: the edge's order within its plane
+    uint32_t corner;  // 3 * face + v
+  };
+  std::vector<std::vector<CornerRef>> planeCorners(planes);
+  std::vector<size_t> planeVertices(planes, 0);
+  report.parallelFor(planes, [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t p = r.begin(); p != r.end(); ++p) {
+      std::vector<CornerRef>& refs = planeCorners[p];
+      for (size_t l = p == 0 ? 0 : p - 1; l <= std::min(p, layers - 1); ++l)
+        for (size_t t = 0; t < marched[l].triangles.size(); ++t)
+          for (size_t v = 0; v < 3; ++v) {
+            const EdgeId& e = marched[l].triangles[t][v];
+            if (e.point / planeSize == p)
+              refs.push_back({(e.point % planeSize) << 3 | e.dir, uint32_t(3 * (firstTriangle[l] + t) + v)});
+          }
+      std::sort(refs.begin(), refs.end(), [](const CornerRef& a, const CornerRef& b) { return a.key < b.key; });
+      size_t distinct = 0;
+      for (size_t c = 0; c < refs.size(); ++c) distinct += c == 0 || refs[c].key != refs[c - 1].key;
+      planeVertices[p] = distinct;
+    }
+  });
+  std::vector<size_t> firstVertex(planes + 1, 0);
+  for (size_t p = 0; p < planes; ++p) firstVertex[p + 1] = firstVertex[p] + planeVertices[p];
+  const size_t vertexCount = firstVertex[planes];
+  if (vertexCount > std::numeric_limits<uint32_t>::max())
+    fail<LimitError>("surface: ", vertexCount, " vertices and ", triangleCount,
                      " triangles, more than a mesh of 32-bit indices holds");
 
   VoxelMesh mesh;
-  mesh.positions.resize(edges.size());
-  for (size_t v = 0; v < edges.size(); ++v) {
-    const std::array<int64_t, 3> lo = marcher.lowerEnd(edges[v]);
-    const auto dir = uint8_t(edges[v].dir);
-    // The edge seen from the cube whose lowest corner is its lower end: corners 0 and dir.
-    std::array<Corner, 8> c;
-    c[0] = band.at(lo[0], lo[1], lo[2]);
-    c[dir] = band.at(lo[0] + (dir & 1), lo[1] + ((dir >> 1) & 1), lo[2] + ((dir >> 2) & 1));
-    mesh.positions[v] = marcher.position(lo, 0, dir, c, grid, level);
-  }
-  mesh.faceStart.resize(marcher.triangles.size() + 1);
-  mesh.faceVertices.resize(marcher.triangles.size() * 3);
-  for (size_t f = 0; f < marcher.triangles.size(); ++f) {
-    mesh.faceStart[f + 1] = uint32_t(3 * (f + 1));
-    for (int v = 0; v < 3; ++v) {
-      const auto it = std::lower_bound(edges.begin(), edges.end(), marcher.triangles[f][v]);
-      mesh.faceVertices[3 * f + v] = uint32_t(it - edges.begin());
+  report.phase(0.9, 1);
+  mesh.positions.resize(vertexCount);
+  mesh.faceStart.resize(triangleCount + 1);
+  mesh.faceVertices.resize(triangleCount * 3);
+  report.parallelFor(planes, [&](const tbb::blocked_range<size_t>& r) {
+    const Marcher& m = marched[0];
+    for (size_t p = r.begin(); p != r.end(); ++p) {
+      size_t vertex = firstVertex[p];
+      const std::vector<CornerRef>& refs = planeCorners[p];
+      for (size_t c = 0; c < refs.size(); ++c) {
+        if (c > 0 && refs[c].key == refs[c - 1].key) {
+          mesh.faceVertices[refs[c].corner] = uint32_t(vertex - 1);
+          continue;
+        }
+        const EdgeId edge{p * planeSize + (refs[c].key >> 3), refs[c].key & 7};
+        const std::array<int64_t, 3> lo = m.lowerEnd(edge);
+        const auto dir = uint8_t(edge.dir);
+        // The edge seen from the cube whose lowest corner is its lower end: corners 0 and dir.
+        std::array<Corner, 8> corners;
+        corners[0] = band.at(lo[0], lo[1], lo[2]);
+        corners[dir] = band.at(lo[0] + (dir & 1), lo[1] + ((dir >> 1) & 1), lo[2] + ((dir >> 2) & 1));
+        mesh.positions[vertex] = m.position(lo, 0, dir, corners, grid, level);
+        mesh.faceVertices[refs[c].corner] = uint32_t(vertex++);
+      }
     }
-  }
+  });
+  for (size_t f = 0; f < triangleCount; ++f) mesh.faceStart[f + 1] = uint32_t(3 * (f + 1));
+  report.check();
   if (progress && !progress(1)) throw Error("surface cancelled");
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (statsOut) *statsOut = stats;

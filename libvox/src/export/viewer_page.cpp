@@ -15,6 +15,7 @@
 
 #include "vox/core/error.h"
 #include "vox/core/exact_number.h"
+#include "vox/export/level_surface.h"
 #include "vox/io/atomic_file.h"
 
 #ifdef VOX_HAVE_VIEWER_SCRIPT
@@ -378,6 +379,12 @@ std::string encodeViewerData(const Grid& grid, const Scene& scene, const ViewerP
   const uint32_t countWidth = widthFor(maxCount);
   const uint32_t paletteWidth = widthFor(palette.empty() ? 0 : palette.size() - 1);
 
+  // The level surface (issue 47, flag bit 10): the band's level set 0 as vox-export --surface writes it, which the
+  // page shows beside the voxels; only when the band holds level 0 (largestSurfaceLevel, else --surface refuses).
+  const bool hasLevel = hasBand && largestSurfaceLevel(grid) >= 0;
+  const VoxelMesh level = hasLevel ? extractLevelSurface(grid, 0.0, nullptr, share(0.7, 0.05)) : VoxelMesh{};
+  cancel(0.75);
+
   const Camera camera = scene.camera ? *scene.camera : defaultCamera(grid.bounds);
   const Vec3 centre = (grid.bounds.lo + grid.bounds.hi) * 0.5;
   const std::string title = options.title;
@@ -386,13 +393,13 @@ std::string encodeViewerData(const Grid& grid, const Scene& scene, const ViewerP
   w.bytes.reserve(kViewerHeaderBytes + pageVertexSource.size() * (3 * coordWidth + 3) + triangles.size() * 4 +
                   nOcc * (coordWidth + countWidth + paletteWidth) + idCount * 4 +
                   (band.keys.size() + band.start.size()) * 4 + band.i.size() * (coordWidth + 4) +
-                  grid.fractions.size() * 4);
+                  grid.fractions.size() * 4 + level.vertexCount() * 12 + level.faceVertices.size() * 4 + 16);
   w.bytes.append("VOXVIEW", 8);  // with its terminating zero
   w.put(kViewerDataVersion);
   const uint32_t flags = (colors ? 1u : 0u) | (wide ? 2u : 0u) | widthCode(countWidth) << 2 |
                          widthCode(paletteWidth) << 4 | (camera.kind == CameraKind::Orthographic ? 64u : 0u) |
                          (camera.span == CameraSpan::LongerSide ? 128u : 0u) | (hasBand ? 256u : 0u) |
-                         (hasFractions ? 512u : 0u);
+                         (hasFractions ? 512u : 0u) | (hasLevel ? 1024u : 0u);
   w.put(flags);
   for (int a = 0; a < 3; ++a) w.put(grid.bounds.lo[a]);
   for (int a = 0; a < 3; ++a) w.put(grid.bounds.hi[a]);
@@ -485,12 +492,25 @@ std::string encodeViewerData(const Grid& grid, const Scene& scene, const ViewerP
   }
   w.align();
   putFields(w, grid, band, hasBand, coordWidth);
+  if (hasLevel) {
+    // Counts checked by extractLevelSurface (at most 2^32 - 1); positions as the scene's triangles: float, relative
+    // to the bounds' centre (the surface's vertices lie between cell centres, not on the lattice of boundaries).
+    w.put(uint32_t(level.vertexCount()));
+    w.put(uint32_t(level.faceCount()));
+    for (const Vec3& p : level.positions)
+      for (int a = 0; a < 3; ++a) w.put(float(p[a] - centre[a]));
+    w.align();
+    for (uint32_t v : level.faceVertices) w.put(v);
+    w.align();
+  }
 
   if (stats) {
     stats->voxels = nOcc + grid.solidCount();  // a grid's cells are occupied or solid, never both
     stats->surfaceVertices = pageVertexSource.size();
     stats->surfaceTriangles = mesh.faceCount();
     stats->storedIds = idCount;
+    stats->levelVertices = level.vertexCount();
+    stats->levelTriangles = level.faceCount();
     stats->dataBytes = w.bytes.size();
   }
   return std::move(w.bytes);

@@ -34,8 +34,10 @@ struct ViewerDataStats {
   uint64_t surfaceVertices = 0;   // lattice points of the merged surface, one per point and colour
   uint64_t surfaceTriangles = 0;  // triangles of the merged surface (the --faces merged mesh, triangulated)
   uint64_t storedIds = 0;         // primitive ids kept (at most idsPerCell per cell)
-  uint64_t dataBytes = 0;         // the binary layout
-  uint64_t pageBytes = 0;         // the HTML file (writeViewerPage only)
+  uint64_t levelVertices = 0;     // the level surface's (flag bit 10; 0 without one)
+  uint64_t levelTriangles = 0;
+  uint64_t dataBytes = 0;  // the binary layout
+  uint64_t pageBytes = 0;  // the HTML file (writeViewerPage only)
 };
 
 // The grid's data as the page reads it (docs/viewer-format.md, version kViewerDataVersion), little-endian:
@@ -49,7 +51,10 @@ struct ViewerDataStats {
 //  - the scene's triangles and spheres (float, relative to the bounds' centre), for the page's triangle overlay;
 //  - when the grid has them (flags bits 8 and 9), the signed-distance band in the same row form as the occupied
 //    cells with each distance as float32, and each occupied cell's volume fraction as float32, which the page's
-//    slice plane shows. A grid without them gives the layout it gave before they existed.
+//    slice plane shows. A grid without them gives the layout it gave before they existed;
+//  - when the band holds level 0 (largestSurfaceLevel(grid) >= 0; flag bit 10), the level surface
+//    extractLevelSurface(grid, 0) as vox-export --surface writes it: its counts, float positions relative to the
+//    bounds' centre and triangles, which the page shows beside the voxels.
 // Colours are vox-export's (occupiedCellColors; solid cells kSolidCellColor); ColorMode::None stores none.
 // Throws InputError for an inconsistent grid (as buildVoxelMesh), LimitError when a count exceeds the layout's 32-bit
 // fields (more than 2^32 - 1 vertices, triangles, cells, band cells or ids, or ny * nz >= 2^32). InputError also

@@ -32,8 +32,10 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 
 
 def stats(cmd):
-    """Runs a tool that prints `name: value` lines (vox-voxelize --stats on stderr, openvdb_sdf on stdout)."""
-    proc = subprocess.run(cmd, capture_output=True, text=True, check=True)
+    """Runs a tool that prints `name: value` lines (vox-voxelize --stats on stderr, openvdb_sdf on stdout). Through a
+    shell that forks it: Linux carries a process's peak resident size across exec, so a tool started straight from
+    this Python process (hundreds of MB with the subdivided meshes) would report Python's peak as its own."""
+    proc = subprocess.run(["sh", "-c", '"$@"; exit $?', "sh", *cmd], capture_output=True, text=True, check=True)
     fields = {}
     for line in (proc.stdout + proc.stderr).splitlines():
         name, sep, value = line.partition(": ")

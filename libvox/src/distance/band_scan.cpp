@@ -148,6 +148,26 @@ void tileRange(const Reachable& c, const int64_t t0[3], const std::array<std::ve
   }
 }
 
+// Every cell of primitive p's reach box in the tile: visit(its slot of `nearest`, its centre). The boxes route takes
+// every primitive this way, the scan route the spheres and ellipsoids.
+template <typename Visit>
+void forCellsInReach(const Primitives& primitives, size_t p, const int64_t t0[3], std::vector<double>& nearest,
+                     const Visit& visit) {
+  const auto& centres = primitives.centres;
+  int64_t lo[3], hi[3];
+  tileRange(primitives.reach(p), t0, centres, lo, hi);
+  for (int64_t k = lo[2]; k <= hi[2]; ++k)
+    for (int64_t j = lo[1]; j <= hi[1]; ++j)
+      for (int64_t i = lo[0]; i <= hi[0]; ++i)
+        visit(nearest[tileIndex(i - t0[0], j - t0[1], k - t0[2])],
+              Vec3{centres[0][size_t(i)], centres[1][size_t(j)], centres[2][size_t(k)]});
+}
+
+double squaredDistanceToShape(const Primitives& primitives, size_t shape, const Vec3& c) {
+  const Vec3 d = c - closestPointOnEllipsoid(primitives.shapes[shape], c);
+  return dot(d, d);
+}
+
 }  // namespace
 
 void TileEvaluator::evaluate(const Primitives& primitives, Route route, const int64_t t0[3], const uint32_t* prims,
@@ -161,27 +181,16 @@ void TileEvaluator::evaluate(const Primitives& primitives, Route route, const in
 
 void TileEvaluator::boxes(const Primitives& primitives, const int64_t t0[3], const uint32_t* prims, size_t count,
                           std::vector<double>& nearest) {
-  const Scene& scene = primitives.scene;
-  const auto& centres = primitives.centres;
+  const size_t triangles = primitives.scene.triangles.size();
   for (size_t q = 0; q < count; ++q) {
     const size_t p = prims[q];
-    int64_t lo[3], hi[3];
-    tileRange(primitives.reach(p), t0, centres, lo, hi);
-    for (int64_t k = lo[2]; k <= hi[2]; ++k)
-      for (int64_t j = lo[1]; j <= hi[1]; ++j)
-        for (int64_t i = lo[0]; i <= hi[0]; ++i) {
-          double& slot = nearest[tileIndex(i - t0[0], j - t0[1], k - t0[2])];
-          const Vec3 c{centres[0][size_t(i)], centres[1][size_t(j)], centres[2][size_t(k)]};
-          double d2;
-          if (p < scene.triangles.size()) {
-            d2 = squaredDistanceToTriangleWithin(scene.triangles[p], primitives.bounds[p], c,
-                                                 std::min(slot, primitives.reach2));
-          } else {
-            const Vec3 d = c - closestPointOnEllipsoid(primitives.shapes[p - scene.triangles.size()], c);
-            d2 = dot(d, d);
-          }
-          if (d2 < slot) slot = d2;
-        }
+    forCellsInReach(primitives, p, t0, nearest, [&](double& slot, const Vec3& c) {
+      const double d2 = p < triangles
+                            ? squaredDistanceToTriangleWithin(primitives.scene.triangles[p], primitives.bounds[p], c,
+                                                              std::min(slot, primitives.reach2))
+                            : squaredDistanceToShape(primitives, p - triangles, c);
+      if (d2 < slot) slot = d2;
+    });
   }
 }
 
@@ -275,17 +284,10 @@ void TileEvaluator::scan(const Primitives& primitives, const int64_t t0[3], cons
   for (size_t q = 0; q < count; ++q) {
     const size_t p = prims[q];
     if (p < triangles) continue;
-    int64_t lo[3], hi[3];
-    tileRange(primitives.reach(p), t0, centres, lo, hi);
-    for (int64_t k = lo[2]; k <= hi[2]; ++k)
-      for (int64_t j = lo[1]; j <= hi[1]; ++j)
-        for (int64_t i = lo[0]; i <= hi[0]; ++i) {
-          double& slot = nearest[tileIndex(i - t0[0], j - t0[1], k - t0[2])];
-          const Vec3 c{centres[0][size_t(i)], centres[1][size_t(j)], centres[2][size_t(k)]};
-          const Vec3 d = c - closestPointOnEllipsoid(primitives.shapes[p - triangles], c);
-          const double d2 = dot(d, d);
-          if (d2 < slot) slot = d2;
-        }
+    forCellsInReach(primitives, p, t0, nearest, [&](double& slot, const Vec3& c) {
+      const double d2 = squaredDistanceToShape(primitives, p - triangles, c);
+      if (d2 < slot) slot = d2;
+    });
   }
 }
 

@@ -30,12 +30,6 @@ f 9 10 11
 OBJ
 } >"$tmp/scene.obj"
 "$build/vox-voxelize" "$tmp/scene.obj" -o "$tmp/g.vgrid" --grid 14 10 10 --quiet || { echo "FAIL: voxelize"; exit 1; }
-cat >"$tmp/topo.mlx" <<'MLX'
-<!DOCTYPE FilterScript>
-<FilterScript>
- <filter name="Compute Topological Measures"/>
-</FilterScript>
-MLX
 
 # Meshes to check: "NAME MESH" lines; all are opened in one Xvfb session below.
 list=$tmp/meshes.txt
@@ -102,33 +96,8 @@ else
   echo "note: $seed missing, course scenes not checked"
 fi
 
-# One Xvfb for every run, two meshlabserver runs at a time; each run's log in its own file.
-cat >"$tmp/one.sh" <<'SH'
-timeout 120 meshlabserver -i "$3" -s "$1/topo.mlx" >"$1/$2.log" 2>&1
-SH
-(cd "$tmp" && timeout 900 xvfb-run -a xargs -P 2 -n 2 bash "$tmp/one.sh" "$tmp" <"$list") >"$tmp/xvfb.log" 2>&1
-# meshlabserver now and then prints nothing at all (seen once in 79 runs under load, its log empty): such a run is
-# tried once more, alone. A run that prints its topology is never retried, so a real defect still fails.
-while read -r name mesh; do
-  grep -q "Boundary Edges" "$tmp/$name.log" 2>/dev/null || echo "$name $mesh"
-done <"$list" >"$tmp/retry"
-if [ -s "$tmp/retry" ]; then
-  echo "note: retrying $(wc -l <"$tmp/retry") meshlabserver run(s) that printed nothing"
-  (cd "$tmp" && timeout 600 xvfb-run -a xargs -P 1 -n 2 bash "$tmp/one.sh" "$tmp" <"$tmp/retry") >>"$tmp/xvfb.log" 2>&1
-fi
-checked=0
-while read -r name mesh; do
-  log="$tmp/$name.log"
-  if ! grep -q "Boundary Edges" "$log" 2>/dev/null; then
-    fail "$name: meshlabserver printed no topology ($(tail -3 "$log" "$tmp/xvfb.log" 2>/dev/null | tr '\n' ' '))"
-    continue
-  fi
-  checked=$((checked + 1))
-  grep -q "Boundary Edges 0" "$log" || fail "$name: $(grep -m1 'Boundary Edges' "$log")"
-  grep -q "Mesh is two-manifold" "$log" || fail "$name: not two-manifold: $(grep -m1 -i 'non two manifold' "$log")"
-  echo "$name: $(grep -m1 'V: ' "$log" | sed 's/LOG: [0-9]* //'), $(grep -m1 -o 'Genus is [-0-9]*' "$log")"
-  rm -f "$mesh"
-done <"$list"
-echo "export_meshlab: $checked meshes checked"
+source "$src/tests/cli/lib/meshlab_topology.sh"
+meshlab_topology "$tmp" "$list"
+echo "export_meshlab: $meshlab_checked meshes checked"
 if [ "$failures" -gt 0 ]; then echo "$failures failure(s)"; exit 1; fi
 echo "export_meshlab: MeshLab reports closed two-manifold meshes"

@@ -107,33 +107,9 @@ fi
 if ! command -v meshlabserver >/dev/null || ! command -v xvfb-run >/dev/null; then
   echo "note: meshlabserver or xvfb-run not installed, MeshLab not checked"
 else
-  cat >"$tmp/topo.mlx" <<'MLX'
-<!DOCTYPE FilterScript>
-<FilterScript>
- <filter name="Compute Topological Measures"/>
-</FilterScript>
-MLX
-  cat >"$tmp/one.sh" <<'SH'
-timeout 120 meshlabserver -i "$3" -s "$1/topo.mlx" >"$1/$2.log" 2>&1
-SH
-  (cd "$tmp" && timeout 900 xvfb-run -a xargs -P 2 -n 2 bash "$tmp/one.sh" "$tmp" <"$list") >"$tmp/xvfb.log" 2>&1
-  # As export_meshlab.sh: a run that printed nothing at all is tried once more, alone.
-  while read -r name mesh; do
-    grep -q "Boundary Edges" "$tmp/$name.log" 2>/dev/null || echo "$name $mesh"
-  done <"$list" >"$tmp/retry"
-  if [ -s "$tmp/retry" ]; then
-    (cd "$tmp" && timeout 600 xvfb-run -a xargs -P 1 -n 2 bash "$tmp/one.sh" "$tmp" <"$tmp/retry") >>"$tmp/xvfb.log" 2>&1
-  fi
-  checked=0
-  while read -r name mesh; do
-    log="$tmp/$name.log"
-    grep -q "Boundary Edges" "$log" 2>/dev/null || { fail "$name: meshlabserver printed no topology"; continue; }
-    checked=$((checked + 1))
-    grep -q "Boundary Edges 0" "$log" || fail "$name: $(grep -m1 'Boundary Edges' "$log")"
-    grep -q "Mesh is two-manifold" "$log" || fail "$name: not two-manifold: $(grep -m1 -i 'non two manifold' "$log")"
-    echo "$name: $(grep -m1 'V: ' "$log" | sed 's/LOG: [0-9]* //'), $(grep -m1 -o 'Genus is [-0-9]*' "$log")"
-  done <"$list"
-  echo "export_surface: MeshLab checked $checked surfaces"
+  source "$src/tests/cli/lib/meshlab_topology.sh"
+  meshlab_topology "$tmp" "$list"
+  echo "export_surface: MeshLab checked $meshlab_checked surfaces"
 fi
 if [ "$failures" -gt 0 ]; then echo "$failures failure(s)"; exit 1; fi
 echo "export_surface: closed two-manifold surfaces, refusals as documented"

@@ -32,28 +32,8 @@ using vox::Vec3;
 using vox::bench::Clock;
 using vox::bench::seconds;
 
-struct Poly {
-  std::array<Vec3, 12> v;
-  int n = 0;
-};
-
-// Sutherland-Hodgman: keeps coordinate `axis` <= value (below) or >= value.
-Poly clip(const Poly& in, int axis, double value, bool below) {
-  Poly out;
-  for (int i = 0; i < in.n; ++i) {
-    const Vec3& p = in.v[i];
-    const Vec3& q = in.v[(i + 1) % in.n];
-    const bool pIn = below ? p[axis] <= value : p[axis] >= value;
-    const bool qIn = below ? q[axis] <= value : q[axis] >= value;
-    if (pIn) out.v[out.n++] = p;
-    if (pIn != qIn) {
-      Vec3 r = p + (q - p) * ((value - p[axis]) / (q[axis] - p[axis]));
-      r.at(axis) = value;
-      out.v[out.n++] = r;
-    }
-  }
-  return out;
-}
+using vox::volume::clipPolygon;
+using Poly = vox::volume::Polygon;
 
 struct Scratch {
   std::vector<uint32_t> prims;
@@ -84,10 +64,10 @@ void rowFractions(const vox::Grid& grid, const vox::Scene& scene, size_t c0, siz
     Poly poly;
     poly.n = 3;
     for (int v = 0; v < 3; ++v) poly.v[v] = {t.v[v].x, t.v[v].y - y0, t.v[v].z - z0};
-    poly = clip(poly, 1, 0, false);
-    if (poly.n > 2) poly = clip(poly, 1, y1 - y0, true);
-    if (poly.n > 2) poly = clip(poly, 2, 0, false);
-    if (poly.n > 2) poly = clip(poly, 2, z1 - z0, true);
+    poly = clipPolygon(poly, 1, 0, false);
+    if (poly.n > 2) poly = clipPolygon(poly, 1, y1 - y0, true);
+    if (poly.n > 2) poly = clipPolygon(poly, 2, 0, false);
+    if (poly.n > 2) poly = clipPolygon(poly, 2, z1 - z0, true);
     if (poly.n < 3) continue;
     double xmin = poly.v[0].x, xmax = xmin;
     for (int v = 1; v < poly.n; ++v) xmin = std::min(xmin, poly.v[v].x), xmax = std::max(xmax, poly.v[v].x);
@@ -97,7 +77,7 @@ void rowFractions(const vox::Grid& grid, const vox::Scene& scene, size_t c0, siz
     for (;; ++i) {
       const double xa = boundary(0, i), xb = boundary(0, i + 1);
       const bool last = i == ihi || xmax <= xb;
-      const Poly piece = last ? poly : clip(poly, 0, xb, true);
+      const Poly piece = last ? poly : clipPolygon(poly, 0, xb, true);
       double f = 0, a = 0;
       for (int v = 1; v + 1 < piece.n; ++v) {
         const Vec3 e = piece.v[v] - piece.v[0], g = piece.v[v + 1] - piece.v[0];
@@ -108,7 +88,7 @@ void rowFractions(const vox::Grid& grid, const vox::Scene& scene, size_t c0, siz
       s.flux[i - ilo] += f / 6;
       s.area[i - ilo] += a / 2;
       if (last) break;
-      poly = clip(poly, 0, xb, false);
+      poly = clipPolygon(poly, 0, xb, false);
       if (poly.n < 3) break;
     }
   }
@@ -182,8 +162,8 @@ double zOnlyFlux(const vox::Triangle& t, const vox::volume::CellPlanes& c) {
   Poly poly;
   poly.n = 3;
   for (int i = 0; i < 3; ++i) poly.v[i] = {t.v[i].x - c.lo[0], t.v[i].y - c.lo[1], t.v[i].z - c.lo[2]};
-  poly = clip(poly, 2, 0, false);
-  if (poly.n > 2) poly = clip(poly, 2, c.hi[2] - c.lo[2], true);
+  poly = clipPolygon(poly, 2, 0, false);
+  if (poly.n > 2) poly = clipPolygon(poly, 2, c.hi[2] - c.lo[2], true);
   double flux = 0;
   for (int i = 1; i + 1 < poly.n; ++i) {
     const Vec3 a = poly.v[i] - poly.v[0], b = poly.v[i + 1] - poly.v[0];

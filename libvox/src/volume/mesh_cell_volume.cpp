@@ -101,31 +101,6 @@ double sectionFlux(const Triangle& t, const CellPlanes& c) {
   return (q.z - p.z) * (0.5 * (p.y + q.y) + hy);
 }
 
-struct Polygon {
-  std::array<Vec3, 9> v;  // a triangle clipped by six planes has at most 9 corners
-  int n = 0;
-};
-
-// Sutherland and Hodgman (1974): keeps the part with coordinate `axis` <= value (keepBelow) or >= value. Points
-// made on the plane get the plane's coordinate exactly.
-Polygon clipPolygon(const Polygon& in, int axis, double value, bool keepBelow) {
-  Polygon out;
-  for (int i = 0; i < in.n; ++i) {
-    const Vec3& p = in.v[i];
-    const Vec3& q = in.v[(i + 1) % in.n];
-    const bool pIn = keepBelow ? p[axis] <= value : p[axis] >= value;
-    const bool qIn = keepBelow ? q[axis] <= value : q[axis] >= value;
-    if (pIn) out.v[out.n++] = p;
-    if (pIn != qIn) {
-      const double t = (value - p[axis]) / (q[axis] - p[axis]);
-      Vec3 r = p + (q - p) * t;
-      r.at(axis) = value;
-      out.v[out.n++] = r;
-    }
-  }
-  return out;
-}
-
 // The flux of (x - x0, 0, 0) through the part of t inside the cell: the integral of (x - x0) n_x dA, i.e. the
 // yz-projected signed area of each fan triangle times the mean x of its corners (x is affine on the plane).
 double clippedFlux(const Triangle& t, const CellPlanes& c) {
@@ -170,6 +145,24 @@ double cellMeshVolume(std::span<const Triangle* const> triangles, const CellPlan
   }
   const double hx = cell.hi[0] - cell.lo[0], hy = cell.hi[1] - cell.lo[1];
   return flux + hx * (face + hy * edgeIntegral);
+}
+
+Polygon clipPolygon(const Polygon& in, int axis, double value, bool keepBelow) {
+  Polygon out;
+  for (int i = 0; i < in.n; ++i) {
+    const Vec3& p = in.v[i];
+    const Vec3& q = in.v[(i + 1) % in.n];
+    const bool pIn = keepBelow ? p[axis] <= value : p[axis] >= value;
+    const bool qIn = keepBelow ? q[axis] <= value : q[axis] >= value;
+    if (pIn) out.v[out.n++] = p;
+    if (pIn != qIn) {
+      const double t = (value - p[axis]) / (q[axis] - p[axis]);
+      Vec3 r = p + (q - p) * t;
+      r.at(axis) = value;
+      out.v[out.n++] = r;
+    }
+  }
+  return out;
 }
 
 }  // namespace vox::volume

@@ -6,6 +6,7 @@
 // perturbation, is the unperturbed one.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -13,6 +14,15 @@
 #include "vox/core/scene.h"
 
 namespace vox::volume {
+
+struct Polygon {
+  std::array<Vec3, 9> v;  // a triangle clipped by six planes has at most 9 corners
+  int n = 0;
+};
+
+// Sutherland and Hodgman (1974): keeps the part with coordinate `axis` <= value (keepBelow) or >= value. Points
+// made on the plane get the plane's coordinate exactly. At most one corner more than `in`.
+Polygon clipPolygon(const Polygon& in, int axis, double value, bool keepBelow);
 
 // A cell's boundaries (cellBoundary), world space.
 struct CellPlanes {

@@ -197,6 +197,7 @@ def audit_calls(tmp_path):
     return {
         "voxelize": (libvox.voxelize, ((V, F),)),
         "sdf": (libvox.sdf, ((V, F),)),
+        "surface": (libvox.surface, ((V, F),)),
         "voxelize_batch": (libvox.voxelize_batch, ([(V, F)],)),
         "load": (libvox.load, (tmp_path / "g.vgrid",)),
         "render": (libvox.render, (grid,)),
@@ -210,6 +211,7 @@ def audit_calls(tmp_path):
         "Grid.occluded": (grid.occluded, ray),
         "Grid.distance": (grid.distance, ([[0, 0, 0]],)),
         "Grid.mesh": (grid.mesh, ()),
+        "Grid.surface": (grid.surface, ()),
         "Grid.colors": (grid.colors, ()),
         "Grid.__repr__": (grid.__repr__, ()),
         "Grid.__reduce__": (grid.__reduce__, ()),
@@ -236,9 +238,9 @@ def positional_count(function):
     return len(args.posonlyargs + args.args) - (1 if args.args and args.args[0].arg == "self" else 0)
 
 
-AUDITED = ["voxelize", "sdf", "voxelize_batch", "load", "render", "save_image", "_voxelize_loop", "_grid_from_state",
+AUDITED = ["voxelize", "sdf", "surface", "voxelize_batch", "load", "render", "save_image", "_voxelize_loop", "_grid_from_state",
            "Grid.save", "Grid.dense", "Grid.contains", "Grid.intersect", "Grid.occluded", "Grid.distance", "Grid.mesh",
-           "Grid.colors", "Grid.__repr__", "Grid.__reduce__", "Grid.__getstate__", "Grid.__setstate__"]
+           "Grid.surface", "Grid.colors", "Grid.__repr__", "Grid.__reduce__", "Grid.__getstate__", "Grid.__setstate__"]
 
 
 @pytest.mark.parametrize("name", AUDITED)

@@ -87,6 +87,7 @@ int gRegistered = 0;                                      // temporary files and
 std::array<struct sigaction, kSignals.size()> gPrevious;  // what each replaced disposition was
 std::array<bool, kSignals.size()> gReplaced{};
 bool gXfszIgnored = false;
+struct sigaction gXfszPrevious {};
 
 bool isDefault(const struct sigaction& a) { return !(a.sa_flags & SA_SIGINFO) && a.sa_handler == SIG_DFL; }
 
@@ -110,8 +111,13 @@ void acquireSignalHandlers() {
   }
   // A write past RLIMIT_FSIZE then fails with EFBIG, which the writers report ("File too large") and which
   // removes the temporary file, instead of SIGXFSZ killing the process with the temporary file left behind.
-  struct sigaction xfsz {};
-  gXfszIgnored = ::sigaction(SIGXFSZ, nullptr, &xfsz) == 0 && isDefault(xfsz) && ::signal(SIGXFSZ, SIG_IGN) != SIG_ERR;
+  // sigaction, not signal(): glibc's signal() adds SA_RESTART and the signal to the mask, so restoring with it would
+  // not give back the disposition found (the sanitizers' signal() does so too).
+  struct sigaction xfsz {
+  }, ignore{};
+  ignore.sa_handler = SIG_IGN;
+  gXfszIgnored = ::sigaction(SIGXFSZ, nullptr, &xfsz) == 0 && isDefault(xfsz) &&
+                 ::sigaction(SIGXFSZ, &ignore, &gXfszPrevious) == 0;
 }
 
 void releaseSignalHandlers() {
@@ -120,7 +126,7 @@ void releaseSignalHandlers() {
   for (size_t i = 0; i < kSignals.size(); ++i)
     if (gReplaced[i] && stillOurs(kSignals[i], removeTemporariesAndExit))
       ::sigaction(kSignals[i], &gPrevious[i], nullptr);
-  if (gXfszIgnored && stillOurs(SIGXFSZ, SIG_IGN)) ::signal(SIGXFSZ, SIG_DFL);
+  if (gXfszIgnored && stillOurs(SIGXFSZ, SIG_IGN)) ::sigaction(SIGXFSZ, &gXfszPrevious, nullptr);
   gReplaced.fill(false);
   gXfszIgnored = false;
 }

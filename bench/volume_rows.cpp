@@ -164,12 +164,7 @@ double zOnlyFlux(const vox::Triangle& t, const vox::volume::CellPlanes& c) {
   for (int i = 0; i < 3; ++i) poly.v[i] = {t.v[i].x - c.lo[0], t.v[i].y - c.lo[1], t.v[i].z - c.lo[2]};
   poly = clipPolygon(poly, 2, 0, false);
   if (poly.n > 2) poly = clipPolygon(poly, 2, c.hi[2] - c.lo[2], true);
-  double flux = 0;
-  for (int i = 1; i + 1 < poly.n; ++i) {
-    const Vec3 a = poly.v[i] - poly.v[0], b = poly.v[i + 1] - poly.v[0];
-    flux += (a.y * b.z - a.z * b.y) * (poly.v[0].x + poly.v[i].x + poly.v[i + 1].x);
-  }
-  return flux / 6;
+  return vox::volume::polygonFlux(poly);
 }
 
 }  // namespace

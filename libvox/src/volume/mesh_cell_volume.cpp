@@ -115,12 +115,7 @@ double clippedFlux(const Triangle& t, const CellPlanes& c) {
     poly = clipPolygon(poly, axis, 0, false);
     if (poly.n > 2) poly = clipPolygon(poly, axis, c.hi[axis] - c.lo[axis], true);
   }
-  double flux = 0;
-  for (int i = 1; i + 1 < poly.n; ++i) {
-    const Vec3 a = poly.v[i] - poly.v[0], b = poly.v[i + 1] - poly.v[0];
-    flux += (a.y * b.z - a.z * b.y) * (poly.v[0].x + poly.v[i].x + poly.v[i + 1].x);
-  }
-  return flux / 6;
+  return polygonFlux(poly);
 }
 
 }  // namespace
@@ -163,6 +158,15 @@ Polygon clipPolygon(const Polygon& in, int axis, double value, bool keepBelow) {
     }
   }
   return out;
+}
+
+double polygonFlux(const Polygon& poly) {
+  double flux = 0;
+  for (int i = 1; i + 1 < poly.n; ++i) {
+    const Vec3 a = poly.v[i] - poly.v[0], b = poly.v[i + 1] - poly.v[0];
+    flux += (a.y * b.z - a.z * b.y) * (poly.v[0].x + poly.v[i].x + poly.v[i + 1].x);
+  }
+  return flux / 6;
 }
 
 }  // namespace vox::volume

@@ -24,6 +24,10 @@ struct Polygon {
 // made on the plane get the plane's coordinate exactly. At most one corner more than `in`.
 Polygon clipPolygon(const Polygon& in, int axis, double value, bool keepBelow);
 
+// The flux of (x, 0, 0) through the polygon (coordinates relative to the cell's low corner): the yz-projected signed
+// area of each fan triangle times the mean x of its corners.
+double polygonFlux(const Polygon& poly);
+
 // A cell's boundaries (cellBoundary), world space.
 struct CellPlanes {
   double lo[3];

@@ -43,6 +43,16 @@ fi
 # Exports, with the mesh's own counts: "FILE VERTICES FACES TRIANGLES COLOURS" in $tmp/expect.
 : >"$tmp/expect"
 files=()
+# export_mesh MESH TRIANGLES COLOUR GRID ARGS...: vox-export GRID to MESH, and the counts Blender must find in it
+# (vertices and faces from --stats; TRIANGLES empty: the faces themselves, as a surface's are all triangles).
+export_mesh() {
+  local mesh=$1 triangles=$2 colour=$3 grid=$4 vertices count
+  shift 4
+  "$build/vox-export" "$grid" -o "$mesh" "$@" --stats --quiet 2>"$tmp/stats" || { fail "export $mesh"; return; }
+  vertices=$(sed -n 's/^vertices: //p' "$tmp/stats") count=$(sed -n 's/^faces: //p' "$tmp/stats")
+  echo "$mesh $vertices $count ${triangles:-$count} $colour" >>"$tmp/expect"
+  files+=("$mesh")
+}
 for grid in $grids; do
   for faces in exposed merged; do
     for color in material count none; do
@@ -54,12 +64,7 @@ for grid in $grids; do
       [ "$grid" = small ] && [ "$faces" = merged ] && exts="ply obj glb gltf"
       for ext in $exts; do
         mesh="$tmp/${grid}_${faces}_$color.$ext"
-        "$build/vox-export" "$tmp/$grid.vgrid" -o "$mesh" --faces "$faces" --color "$color" --stats --quiet \
-          2>"$tmp/stats" ||
-          { fail "export $mesh"; continue; }
-        vertices=$(sed -n 's/^vertices: //p' "$tmp/stats") count=$(sed -n 's/^faces: //p' "$tmp/stats")
-        echo "$mesh $vertices $count $triangles $color" >>"$tmp/expect"
-        files+=("$mesh")
+        export_mesh "$mesh" "$triangles" "$color" "$tmp/$grid.vgrid" --faces "$faces" --color "$color"
       done
     done
   done
@@ -77,11 +82,7 @@ for case in $surfaces; do
   "$build/vox-voxelize" "$scene" -o "$tmp/$name.vgrid" --res "$res" --sdf --quiet || { fail "voxelize $name"; continue; }
   for ext in glb ply obj stl; do
     mesh="$tmp/${name}_surface.$ext"
-    "$build/vox-export" "$tmp/$name.vgrid" -o "$mesh" --surface --stats --quiet 2>"$tmp/stats" ||
-      { fail "surface $mesh"; continue; }
-    vertices=$(sed -n 's/^vertices: //p' "$tmp/stats") count=$(sed -n 's/^faces: //p' "$tmp/stats")
-    echo "$mesh $vertices $count $count surface" >>"$tmp/expect"
-    files+=("$mesh")
+    export_mesh "$mesh" "" surface "$tmp/$name.vgrid" --surface
   done
 done
 

@@ -5,6 +5,7 @@
 // needles, slivers and degenerate triangles.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -150,6 +151,64 @@ TEST(NearestPrimitiveWide, FarPointsAndTinyScenes) {
   one.triangles.push_back({{Vec3{0, 0, 0}, Vec3{1, 0, 0}, Vec3{0, 1, 0}}});
   nwPointsOn(one.triangles[0], points);
   nwExpectBrute(one, points, "one triangle");
+}
+
+// Regions as the dense field's bricks make them: a centre, a radius and the bound `upper` from the centre's own
+// nearest. Every point of the region, searched from its frontier, gets brute force's primitive and double, on
+// regions around vertices, edges and faces and one ulp off, at every scale and offset; and a bound set below the
+// truth loses some answers, so the comparison can see a frontier that drops a subtree it needs.
+size_t nwFrontierMismatches(const Scene& s, uint64_t seed, double shrinkUpper) {
+  std::vector<EllipsoidShape> shapes;
+  for (const Sphere& sp : s.spheres) shapes.push_back(ellipsoidShape(sp));
+  const NearestPrimitive nearest(s);
+  const int64_t n = int64_t(nearest.primitiveCount());
+  const Box b = *sceneBounds(s);
+  const double size = length(b.hi - b.lo);
+  std::vector<Vec3> centres = nwPoints(s, 40, seed);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  NearestPrimitive::Frontier frontier;
+  size_t mismatches = 0;
+  for (size_t c = 0; c < centres.size(); c += 17) {
+    const Vec3 centre = centres[c];
+    const double radius = std::array{0.0, 1e-9, 1e-3, 0.02, 0.2}[c % 5] * size;
+    const double upper = std::sqrt(nearest.nearest(centre).squaredDistance) + radius;
+    nearest.gather(centre, radius, upper * shrinkUpper, 4 + c % 29, frontier);
+    std::vector<Vec3> points{centre};
+    for (int k = 0; k < 12; ++k) {  // inside the ball, some on its rim
+      const Vec3 d{u(rng), u(rng), u(rng)};
+      const double l = length(d);
+      if (l > 0) points.push_back(centre + d * (radius * (k % 3 == 0 ? 1 - 0x1p-30 : std::fabs(u(rng))) / l));
+    }
+    for (const Vec3& near : centres)  // the adversarial points of other triangles that fall in the region
+      if (length(near - centre) < radius) points.push_back(near);
+    for (size_t i = 0; i < points.size(); ++i) {
+      const NearestHit want = nwBrute(s, shapes, points[i]);
+      const NearestHit hit = nearest.nearestFrom(points[i], int64_t(i * 7919 + c) % std::max<int64_t>(n, 1), frontier);
+      mismatches += hit.squaredDistance != want.squaredDistance || hit.primitive != want.primitive;
+    }
+  }
+  return mismatches;
+}
+
+TEST(NearestPrimitiveWide, FrontierSearchesEqualBruteForceInEveryRegion) {
+  for (const char* mesh : {"6837/scenes/bunny_1k.obj", "6837/scenes/cube.obj", "6837/scenes/vase.obj"}) {
+    const Scene s = importObj(testing::seed(mesh));
+    EXPECT_EQ(nwFrontierMismatches(s, 7, 1.0), 0u) << mesh;
+  }
+  const Scene soup = testing::randomScene(9, 400, 6);
+  EXPECT_EQ(nwFrontierMismatches(soup, 8, 1.0), 0u) << "soup";
+  for (const double scale : {1e-6, 1.0, 1e6})
+    for (const double offset : {0.0, 1e6}) {
+      Scene s = importObj(testing::seed("6837/scenes/bunny_200.obj"));
+      for (Triangle& t : s.triangles)
+        for (Vec3& v : t.v) v = v * scale + Vec3{offset, -offset, 0.5 * offset};
+      EXPECT_EQ(nwFrontierMismatches(s, 9, 1.0), 0u) << scale << " " << offset;
+      const PowerOfTwoFrame frame = sceneFrame(s);
+      EXPECT_EQ(nwFrontierMismatches(sceneInFrame(s, frame), 10, 1.0), 0u) << scale << " " << offset << " framed";
+    }
+  const Scene bunny = importObj(testing::seed("6837/scenes/bunny_1k.obj"));
+  EXPECT_GT(nwFrontierMismatches(bunny, 7, 0.5), 0u) << "a bound below the truth must lose answers";
 }
 
 // The 69k bunny's dense field at 64 (which searches cell after cell from the one before's nearest): every cell of

@@ -285,27 +285,79 @@ double NearestPrimitive::squaredDistanceTo(uint32_t slot, const Vec3& p, double 
 
 // The seed's exact distance is the first bound, tight when the seed is the answer or nearly so, so that the search
 // from the root opens few nodes. Ties still go to the lowest id: the seed's equals are visited and win by id.
-NearestHit NearestPrimitive::nearestFrom(const Vec3& p, int64_t seed) const {
-  if (seed < 0 || uint64_t(seed) >= ids_.size()) return nearest(p);
+NearestHit NearestPrimitive::seeded(const Vec3& p, int64_t seed) const {
   NearestHit best;
   best.squaredDistance = squaredDistanceTo(slotOf_[size_t(seed)], p, INFINITY);
   best.primitive = seed;
-  search(p, best);
+  return best;
+}
+
+NearestHit NearestPrimitive::nearestFrom(const Vec3& p, int64_t seed) const {
+  if (seed < 0 || uint64_t(seed) >= ids_.size()) return nearest(p);
+  NearestHit best = seeded(p, seed);
+  search(p, wide_.data(), 1, best, slotOf_[size_t(seed)]);
+  return best;
+}
+
+NearestHit NearestPrimitive::nearestFrom(const Vec3& p, int64_t seed, const Frontier& frontier) const {
+  if (seed < 0 || uint64_t(seed) >= ids_.size()) return nearest(p);
+  NearestHit best = seeded(p, seed);
+  search(p, frontier.nodes_.data(), frontier.nodes_.size(), best, slotOf_[size_t(seed)]);
   return best;
 }
 
 NearestHit NearestPrimitive::nearest(const Vec3& p, double bound2) const {
   NearestHit best;
   best.squaredDistance = bound2;
-  search(p, best);
+  if (!wide_.empty()) search(p, wide_.data(), 1, best);
   if (best.primitive < 0) best.squaredDistance = INFINITY;
   return best;
 }
 
+namespace {
+
+// Float lower bounds of the squared distances from q (relative to the tree's origin) to a node's four children's
+// boxes, each lowered by the rounding allowance (the constants above) below the exact distance of every primitive
+// it holds.
+template <typename Node>
+__m128 childBounds(const Node& node, __m128 qx, __m128 qy, __m128 qz, __m128 qn) {
+  const __m128 zero = _mm_setzero_ps();
+  const __m128 dx = _mm_sub_ps(qx, _mm_load_ps(node.centre[0])), dy = _mm_sub_ps(qy, _mm_load_ps(node.centre[1])),
+               dz = _mm_sub_ps(qz, _mm_load_ps(node.centre[2]));
+  const __m128 allowance = _mm_add_ps(_mm_mul_ps(_mm_add_ps(qn, _mm_load_ps(node.magnitude)), _mm_set1_ps(kRelative)),
+                                      _mm_set1_ps(kAbsolute));
+  const auto outside = [&](int a) {
+    const __m128 u = _mm_add_ps(
+        _mm_add_ps(_mm_mul_ps(_mm_load_ps(node.axis[a][0]), dx), _mm_mul_ps(_mm_load_ps(node.axis[a][1]), dy)),
+        _mm_mul_ps(_mm_load_ps(node.axis[a][2]), dz));
+    const __m128 e = _mm_sub_ps(_mm_max_ps(u, _mm_sub_ps(zero, u)), _mm_add_ps(_mm_load_ps(node.half[a]), allowance));
+    return _mm_max_ps(e, zero);
+  };
+  const __m128 ex = outside(0), ey = outside(1), ez = outside(2);
+  return _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(ex, ex), _mm_mul_ps(ey, ey)), _mm_mul_ps(ez, ez)),
+                    _mm_set1_ps(kShrink));
+}
+
+// A point relative to the tree's origin in float, and whether its float bounds may prune (within kFloatReach).
+struct FloatQuery {
+  bool prune;
+  float q[3] = {0, 0, 0};  // without pruning the bounds are computed at the origin and never compared
+  float norm = 0;
+  FloatQuery(const Vec3& p, const Vec3& origin) {
+    const Vec3 d = p - origin;
+    prune = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)}) <= kFloatReach;
+    if (prune)
+      for (int a = 0; a < 3; ++a) q[a] = float(d[a]);
+    norm = std::fabs(q[0]) + std::fabs(q[1]) + std::fabs(q[2]);
+  }
+};
+
+}  // namespace
+
 // The leaf's triangles' float lower bounds, four at once; the survivors get the double route (which may still prune
 // with the best as it is by then), as the double search gave it to every triangle it reached.
 void NearestPrimitive::visitLeaf(const WideLeaf& leaf, const Vec3& p, const float (&q)[3], float qNorm, bool prune,
-                                 float bestUp, NearestHit& best) const {
+                                 float bestUp, uint32_t known, NearestHit& best) const {
   const __m128 qx = _mm_set1_ps(q[0]), qy = _mm_set1_ps(q[1]), qz = _mm_set1_ps(q[2]), zero = _mm_setzero_ps();
   const auto row = [&](const float(&v)[3][4], const float* w) {
     const __m128 d = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_load_ps(v[0]), qx), _mm_mul_ps(_mm_load_ps(v[1]), qy)),
@@ -320,6 +372,9 @@ void NearestPrimitive::visitLeaf(const WideLeaf& leaf, const Vec3& p, const floa
   const __m128 hl = _mm_max_ps(_mm_sub_ps(h, allowance), zero), sl = _mm_max_ps(_mm_sub_ps(s, allowance), zero);
   const __m128 lb2 = _mm_add_ps(_mm_mul_ps(hl, hl), _mm_mul_ps(sl, sl));
   unsigned open = unsigned(_mm_movemask_ps(_mm_cmple_ps(lb2, _mm_set1_ps(bestUp)))) & ((1u << leaf.count) - 1);
+  // The seed's distance is in `best` already: computed again it would equal it (a tie with its own id) or, once a
+  // nearer primitive has replaced it, lose; either way nothing changes.
+  if (known - leaf.first < leaf.count) open &= ~(1u << (known - leaf.first));
   if (open == 0) return;
   // The survivors nearest bound first, each bound checked again against the best so far: the first exact distance
   // then prunes most of the rest. The answer does not depend on the order (ties go to the lowest id in any order).
@@ -347,64 +402,115 @@ void NearestPrimitive::visitLeaf(const WideLeaf& leaf, const Vec3& p, const floa
 }
 
 // Lowers `best` to the nearest primitive within it (ties to the lowest id): every child whose float box bound is
-// no farther than the best so far (pruneAbove) is visited, nearer children first.
-void NearestPrimitive::search(const Vec3& p, NearestHit& best) const {
-  if (wide_.empty()) return;
-  const Vec3 d = p - origin_;
-  const bool prune = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)}) <= kFloatReach;
-  float q[3] = {0, 0, 0};  // without pruning the bounds are computed at the origin and never compared
-  if (prune)
-    for (int a = 0; a < 3; ++a) q[a] = float(d[a]);
-  const float qNorm = std::fabs(q[0]) + std::fabs(q[1]) + std::fabs(q[2]);
-  const __m128 qx = _mm_set1_ps(q[0]), qy = _mm_set1_ps(q[1]), qz = _mm_set1_ps(q[2]), zero = _mm_setzero_ps();
-  const __m128 qn = _mm_set1_ps(qNorm);
+// no farther than the best so far (pruneAbove) is visited, nearer children first. The search starts from the
+// children of `first` (the root, or a region's frontier).
+void NearestPrimitive::search(const Vec3& p, const WideNode* first, size_t firstCount, NearestHit& best,
+                              uint32_t known) const {
+  const FloatQuery fq(p, origin_);
+  const bool prune = fq.prune;
+  const __m128 qx = _mm_set1_ps(fq.q[0]), qy = _mm_set1_ps(fq.q[1]), qz = _mm_set1_ps(fq.q[2]);
+  const __m128 qn = _mm_set1_ps(fq.norm);
   float bestUp = prune ? pruneAbove(best.squaredDistance) : INFINITY;
-  // Each level pushes at most three more entries than it pops, and the depth is at most 32: 128 hold any tree.
+  // The first nodes push at most kMaxFrontier entries; each level after pushes at most three more than it pops, and
+  // the depth is at most 32.
   struct Waiting {
     int32_t node;
     float d2;
   };
-  std::array<Waiting, 128> stack;
+  std::array<Waiting, kMaxFrontier + 3 * 32 + 4> stack;
   size_t top = 0;
-  int32_t current = 0;
-  for (;;) {
-    const WideNode& node = wide_[size_t(current)];
-    const __m128 dx = _mm_sub_ps(qx, _mm_load_ps(node.centre[0])), dy = _mm_sub_ps(qy, _mm_load_ps(node.centre[1])),
-                 dz = _mm_sub_ps(qz, _mm_load_ps(node.centre[2]));
-    const __m128 allowance = _mm_add_ps(_mm_mul_ps(_mm_add_ps(qn, _mm_load_ps(node.magnitude)), _mm_set1_ps(kRelative)),
-                                        _mm_set1_ps(kAbsolute));
-    const auto outside = [&](int a) {
-      const __m128 u = _mm_add_ps(
-          _mm_add_ps(_mm_mul_ps(_mm_load_ps(node.axis[a][0]), dx), _mm_mul_ps(_mm_load_ps(node.axis[a][1]), dy)),
-          _mm_mul_ps(_mm_load_ps(node.axis[a][2]), dz));
-      const __m128 e = _mm_sub_ps(_mm_max_ps(u, _mm_sub_ps(zero, u)), _mm_add_ps(_mm_load_ps(node.half[a]), allowance));
-      return _mm_max_ps(e, zero);
-    };
-    const __m128 ex = outside(0), ey = outside(1), ez = outside(2);
-    const __m128 lb2 = _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(ex, ex), _mm_mul_ps(ey, ey)), _mm_mul_ps(ez, ez)),
-                                  _mm_set1_ps(kShrink));
+  // Pushes the node's open children so that the nearest of those since `base` is popped first.
+  const auto open = [&](const WideNode& node, size_t base) {
     alignas(16) float bound[4];
+    const __m128 lb2 = childBounds(node, qx, qy, qz, qn);
     _mm_store_ps(bound, lb2);
-    unsigned open = unsigned(_mm_movemask_ps(_mm_cmple_ps(lb2, _mm_set1_ps(bestUp)))) & ((1u << node.count) - 1);
-    // The open children pushed farthest first, so the nearest is popped first.
-    const size_t base = top;
-    for (; open != 0; open &= open - 1) {
-      const int lane = __builtin_ctz(open);
+    unsigned lanes = unsigned(_mm_movemask_ps(_mm_cmple_ps(lb2, _mm_set1_ps(bestUp)))) & ((1u << node.count) - 1);
+    for (; lanes != 0; lanes &= lanes - 1) {
+      const int lane = __builtin_ctz(lanes);
       size_t i = top++;
       for (; i > base && stack[i - 1].d2 < bound[lane]; --i) stack[i] = stack[i - 1];
       stack[i] = {node.child[lane], bound[lane]};
     }
-    for (;;) {
-      if (top == 0) return;
-      const Waiting next = stack[--top];
-      if (next.d2 > bestUp) continue;
-      if (next.node >= 0) {
-        current = next.node;
-        break;
-      }
-      visitLeaf(leaves_[size_t(~next.node)], p, q, qNorm, prune, bestUp, best);
-      if (prune) bestUp = pruneAbove(best.squaredDistance);
+  };
+  for (size_t i = 0; i < firstCount; ++i) open(first[i], 0);
+  while (top > 0) {
+    const Waiting next = stack[--top];
+    if (next.d2 > bestUp) continue;
+    if (next.node >= 0) {
+      open(wide_[size_t(next.node)], top);
+      continue;
     }
+    visitLeaf(leaves_[size_t(~next.node)], p, fq.q, fq.norm, prune, bestUp, known, best);
+    if (prune) bestUp = pruneAbove(best.squaredDistance);
+  }
+}
+
+// Region pruning, from the search's own certificate: a child's float bound b at the region's centre lies below the
+// computed (so, within a relative 2^-50, the real) distance from the centre of every primitive it holds. If
+// sqrt(b) exceeds keep = (upper + radius) (1 + 2^-28) + 2^-60, each such primitive is farther than
+// upper (1 + 2^-28) from every point of the region, and so, with `upper` at least the real distance from that point
+// to some primitive, computed farther than it too: the point's search would have found it farther than its best and
+// never counted it, equal or nearer. The 2^-60 keeps those distances' squares clear of underflow.
+void NearestPrimitive::gather(const Vec3& centre, double radius, double upper, size_t maxEntries,
+                              Frontier& frontier) const {
+  frontier.nodes_.clear();
+  if (wide_.empty()) return;
+  const FloatQuery fq(centre, origin_);
+  const double keep = (upper + radius) * (1 + 0x1p-28) + 0x1p-60;
+  if (!fq.prune || !(keep * keep < double(std::numeric_limits<float>::max()))) {
+    frontier.nodes_.push_back(wide_[0]);
+    return;
+  }
+  const __m128 keep2 = _mm_set1_ps(floatAbove(keep * keep * (1 + 0x1p-26)));
+  const __m128 qx = _mm_set1_ps(fq.q[0]), qy = _mm_set1_ps(fq.q[1]), qz = _mm_set1_ps(fq.q[2]);
+  const __m128 qn = _mm_set1_ps(fq.norm);
+  struct Entry {
+    const WideNode* node;  // the lane's parent
+    int lane;
+    float size;  // the sum of its half extents
+  };
+  std::array<Entry, kMaxFrontier + 4> entries;
+  size_t count = 0;
+  const auto keptChildren = [&](const WideNode& node, std::array<Entry, 4>& out) {
+    const unsigned lanes =
+        unsigned(_mm_movemask_ps(_mm_cmple_ps(childBounds(node, qx, qy, qz, qn), keep2))) & ((1u << node.count) - 1);
+    size_t n = 0;
+    for (unsigned l = lanes; l != 0; l &= l - 1) {
+      const int lane = __builtin_ctz(l);
+      out[n++] = {&node, lane, node.half[0][lane] + node.half[1][lane] + node.half[2][lane]};
+    }
+    return n;
+  };
+  std::array<Entry, 4> children;
+  count = keptChildren(wide_[0], children);
+  std::copy_n(children.begin(), count, entries.begin());
+  maxEntries = std::clamp<size_t>(maxEntries, 4, kMaxFrontier);
+  // The largest inner child replaced by its kept children while they fit.
+  for (;;) {
+    size_t widest = count;
+    for (size_t e = 0; e < count; ++e)
+      if (entries[e].node->child[entries[e].lane] >= 0 && (widest == count || entries[e].size > entries[widest].size))
+        widest = e;
+    if (widest == count) break;
+    const size_t n = keptChildren(wide_[size_t(entries[widest].node->child[entries[widest].lane])], children);
+    if (count - 1 + n > maxEntries) break;
+    entries[widest] = entries[--count];
+    std::copy_n(children.begin(), n, entries.begin() + ptrdiff_t(count));
+    count += n;
+  }
+  // Packed four to a node, lane by lane.
+  for (size_t e = 0; e < count; ++e) {
+    if (e % 4 == 0) frontier.nodes_.push_back(WideNode{});  // unused lanes zero, masked out
+    WideNode& packed = frontier.nodes_.back();
+    const WideNode& from = *entries[e].node;
+    const int lane = entries[e].lane, to = int(packed.count++);
+    for (int a = 0; a < 3; ++a) {
+      packed.centre[a][to] = from.centre[a][lane];
+      packed.half[a][to] = from.half[a][lane];
+      for (int i = 0; i < 3; ++i) packed.axis[a][i][to] = from.axis[a][i][lane];
+    }
+    packed.magnitude[to] = from.magnitude[lane];
+    packed.child[to] = from.child[lane];
   }
 }
 

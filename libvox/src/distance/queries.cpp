@@ -1,5 +1,6 @@
 #include "vox/distance/queries.h"
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
@@ -37,6 +38,11 @@ struct QueryProgress {
 }  // namespace
 
 namespace {
+
+// The dense field's bricks of cells and the most subtrees their frontier keeps: measured with bench/bench_distance
+// (docs/distance.md, "The dense field by bricks").
+constexpr uint32_t kDenseBrick = 4;
+constexpr size_t kDenseFrontier = 16;
 
 void framedDenseSignedDistances(const Grid& grid, const Scene& scene, std::span<double> out,
                                 const std::array<uint64_t, 3>& strides, const DistanceQueryOptions& options);
@@ -90,28 +96,54 @@ void framedDenseSignedDistances(const Grid& grid, const Scene& scene, std::span<
     if (cancelled) fail<Error>("signed distances cancelled");
   }
   const std::array<std::vector<double>, 3> centres = cellCentresByAxis(grid);
-  // Rows run along the axis of the smallest stride, so each row's writes are adjacent and each cell's search starts
-  // from its neighbour's nearest primitive.
+  // Bricks of cells, each brick's rows along the axis of the smallest stride, so each row's writes are adjacent and
+  // each cell's search starts from its neighbour's nearest primitive, and from the brick's frontier: the subtrees
+  // that can hold a nearest primitive of any of its cells, found once for the brick (NearestPrimitive::gather).
   const int along = strides[0] <= strides[1] && strides[0] <= strides[2] ? 0 : (strides[1] <= strides[2] ? 1 : 2);
   const int u = along == 0 ? 1 : 0, v = along == 2 ? 1 : 2;
-  const uint64_t rows = uint64_t(grid.dims[u]) * grid.dims[v], length = grid.dims[along];
-  QueryProgress progress{options, rows, 0.1};
-  tbb::parallel_for(tbb::blocked_range<uint64_t>(0, rows, 16), [&](const tbb::blocked_range<uint64_t>& r) {
+  std::array<uint32_t, 3> bricks;
+  for (int a = 0; a < 3; ++a) bricks[size_t(a)] = (grid.dims[a] + kDenseBrick - 1) / kDenseBrick;
+  const uint64_t brickCount = uint64_t(bricks[0]) * bricks[1] * bricks[2];
+  QueryProgress progress{options, brickCount, 0.1};
+  tbb::enumerable_thread_specific<NearestPrimitive::Frontier> frontiers;
+  tbb::parallel_for(tbb::blocked_range<uint64_t>(0, brickCount, 4), [&](const tbb::blocked_range<uint64_t>& r) {
     if (progress.cancelled) return;
-    for (uint64_t row = r.begin(); row < r.end(); ++row) {
-      uint32_t ijk[3];
-      ijk[u] = uint32_t(row % grid.dims[u]);
-      ijk[v] = uint32_t(row / grid.dims[u]);
-      int64_t previous = -1;  // the nearest primitive of the row's cell before: the next cell's search starts from it
-      for (uint32_t s = 0; s < length; ++s) {
-        ijk[along] = s;
-        const Vec3 c{centres[0][ijk[0]], centres[1][ijk[1]], centres[2][ijk[2]]};
-        const NearestHit hit = nearest.nearestFrom(c, previous);
-        previous = hit.primitive;
-        const double d = std::sqrt(hit.squaredDistance);
-        const bool in = d > 0 && inside[cellKey(grid.dims, ijk[0], ijk[1], ijk[2])];  // on the surface: +0
-        out[ijk[0] * strides[0] + ijk[1] * strides[1] + ijk[2] * strides[2]] = in ? -d : d;
+    NearestPrimitive::Frontier& frontier = frontiers.local();
+    int64_t previous = -1;  // the nearest primitive of the brick before
+    for (uint64_t b = r.begin(); b < r.end(); ++b) {
+      std::array<uint32_t, 3> lo, hi;  // the brick's cells, [lo, hi)
+      const uint64_t index[3] = {b % bricks[0], b / bricks[0] % bricks[1], b / (uint64_t(bricks[0]) * bricks[1])};
+      for (int a = 0; a < 3; ++a) {
+        lo[size_t(a)] = uint32_t(index[a]) * kDenseBrick;
+        hi[size_t(a)] = std::min(lo[size_t(a)] + kDenseBrick, grid.dims[a]);
       }
+      // The brick's middle cell: its nearest primitive's distance plus the farthest cell's bounds every cell's.
+      Vec3 middle;
+      for (int a = 0; a < 3; ++a) middle.at(a) = centres[size_t(a)][(lo[size_t(a)] + hi[size_t(a)] - 1) / 2];
+      const NearestHit first = nearest.nearestFrom(middle, previous);
+      double radius2 = 0;
+      for (int corner = 0; corner < 8; ++corner) {
+        Vec3 c;
+        for (int a = 0; a < 3; ++a) c.at(a) = centres[size_t(a)][corner >> a & 1 ? hi[size_t(a)] - 1 : lo[size_t(a)]];
+        radius2 = std::max(radius2, dot(c - middle, c - middle));
+      }
+      const double radius = std::sqrt(radius2) * (1 + 0x1p-40);  // above the real distance of every cell
+      nearest.gather(middle, radius, (std::sqrt(first.squaredDistance) + radius) * (1 + 0x1p-40), kDenseFrontier,
+                     frontier);
+      previous = first.primitive;
+      uint32_t ijk[3];
+      for (ijk[v] = lo[size_t(v)]; ijk[v] < hi[size_t(v)]; ++ijk[v])
+        for (ijk[u] = lo[size_t(u)]; ijk[u] < hi[size_t(u)]; ++ijk[u]) {
+          int64_t seed = first.primitive;
+          for (ijk[along] = lo[size_t(along)]; ijk[along] < hi[size_t(along)]; ++ijk[along]) {
+            const Vec3 c{centres[0][ijk[0]], centres[1][ijk[1]], centres[2][ijk[2]]};
+            const NearestHit hit = nearest.nearestFrom(c, seed, frontier);
+            seed = hit.primitive;
+            const double d = std::sqrt(hit.squaredDistance);
+            const bool in = d > 0 && inside[cellKey(grid.dims, ijk[0], ijk[1], ijk[2])];  // on the surface: +0
+            out[ijk[0] * strides[0] + ijk[1] * strides[1] + ijk[2] * strides[2]] = in ? -d : d;
+          }
+        }
     }
     progress.report(r.size());
   });

@@ -40,6 +40,19 @@ class NearestPrimitive {
   // first bound, which is tight when the seed is the answer or nearly so, so the search visits few nodes.
   NearestHit nearestFrom(const Vec3& p, int64_t seed) const;
 
+  // The subtrees a search from any point of a small region must open, found once for the region (a brick of a
+  // dense field's cells): the tree's top levels are then walked once per region instead of once per point.
+  class Frontier;
+  // Fills `frontier` for the points within `radius` of `centre` whose nearest primitives are all at most `upper`
+  // away: a subtree whose box is proven farther than `upper` from every such point is left out (it holds no
+  // primitive a search would have compared equal or nearer), and the largest subtrees left are replaced by their
+  // children while at most `maxEntries` (<= kMaxFrontier) remain. Without float pruning (a region beyond its
+  // reach), the frontier is the root's children.
+  void gather(const Vec3& centre, double radius, double upper, size_t maxEntries, Frontier& frontier) const;
+  // nearestFrom for a point of the region `frontier` was gathered for: the same answer, bit for bit.
+  NearestHit nearestFrom(const Vec3& p, int64_t seed, const Frontier& frontier) const;
+  static constexpr size_t kMaxFrontier = 32;
+
   // The point of primitive `id` nearest to p.
   Vec3 closestPoint(int64_t id, const Vec3& p) const;
 
@@ -79,9 +92,13 @@ class NearestPrimitive {
     float centre[3], axis[3][3], half[3];
   };
   double squaredDistanceTo(uint32_t slot, const Vec3& p, double bound2) const;
-  void search(const Vec3& p, NearestHit& best) const;
+  // Lowers `best` to the nearest primitive under the children of nodes[0, count) (ties to the lowest id). `known`:
+  // the slot of a primitive whose distance `best` already took into account (a seed), not computed again.
+  static constexpr uint32_t kNoSlot = UINT32_MAX;
+  void search(const Vec3& p, const WideNode* nodes, size_t count, NearestHit& best, uint32_t known = kNoSlot) const;
+  NearestHit seeded(const Vec3& p, int64_t seed) const;
   void visitLeaf(const WideLeaf& leaf, const Vec3& p, const float (&q)[3], float qNorm, bool prune, float bestUp,
-                 NearestHit& best) const;
+                 uint32_t known, NearestHit& best) const;
   uint32_t build(uint32_t begin, uint32_t end, const std::vector<Vec3>& centroids, std::vector<BinaryNode>& nodes);
   int32_t buildWide(uint32_t index, const std::vector<BinaryNode>& nodes, const std::vector<Box>& nodeBoxes,
                     const std::vector<FloatBox>& floatBoxes);
@@ -98,6 +115,13 @@ class NearestPrimitive {
   Vec3 origin_{0, 0, 0};                    // the centre of the primitives' bounds: the float data's origin
   uint32_t triangleCount_ = 0;
   PowerOfTwoFrame frame_;
+};
+
+// Reused across regions by one thread: its nodes are the frontier's children, four to a node, copied lane by lane.
+class NearestPrimitive::Frontier {
+ private:
+  friend class NearestPrimitive;
+  std::vector<WideNode> nodes_;
 };
 
 }  // namespace vox

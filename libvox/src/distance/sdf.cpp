@@ -55,24 +55,33 @@ std::vector<std::vector<Candidate>> bandCandidates(const Grid& grid, const Scene
   const size_t prims = primitives.count();
   std::array<uint64_t, 3> tiles;
   for (int a = 0; a < 3; ++a) tiles[a] = (grid.dims[a] + kTile - 1) / kTile;
-  // Bins.
-  tbb::enumerable_thread_specific<std::vector<TilePrim>> binLocals;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, prims, 1024), [&](const tbb::blocked_range<size_t>& r) {
-    std::vector<TilePrim>& out = binLocals.local();
-    for (size_t p = r.begin(); p < r.end(); ++p) {
-      const band::Reachable c = primitives.reach(p);
-      if (c.empty()) continue;
-      for (int64_t tz = c.cells[2][0] / kTile; tz <= c.cells[2][1] / kTile; ++tz)
-        for (int64_t ty = c.cells[1][0] / kTile; ty <= c.cells[1][1] / kTile; ++ty)
-          for (int64_t tx = c.cells[0][0] / kTile; tx <= c.cells[0][1] / kTile; ++tx)
-            out.push_back({uint64_t(tx) + tiles[0] * (uint64_t(ty) + tiles[1] * uint64_t(tz)), uint32_t(p)});
-    }
+  // Bins, counted first and then written in place: per-thread vectors grown by push_back and then concatenated
+  // held them twice over at the peak, with their growth's slack (docs/distance.md "Memory").
+  const size_t chunk = 4096, chunks = (prims + chunk - 1) / chunk;
+  const auto forTiles = [&](size_t p, const auto& visit) {
+    const band::Reachable c = primitives.reach(p);
+    if (c.empty()) return;
+    for (int64_t tz = c.cells[2][0] / kTile; tz <= c.cells[2][1] / kTile; ++tz)
+      for (int64_t ty = c.cells[1][0] / kTile; ty <= c.cells[1][1] / kTile; ++ty)
+        for (int64_t tx = c.cells[0][0] / kTile; tx <= c.cells[0][1] / kTile; ++tx)
+          visit(uint64_t(tx) + tiles[0] * (uint64_t(ty) + tiles[1] * uint64_t(tz)));
+  };
+  std::vector<size_t> chunkStarts(chunks + 1, 0);  // each chunk's first bin, after the prefix sum
+  tbb::parallel_for(size_t(0), chunks, [&](size_t k) {
+    size_t n = 0;
+    for (size_t p = k * chunk; p < std::min(prims, (k + 1) * chunk); ++p) forTiles(p, [&](uint64_t) { ++n; });
+    chunkStarts[k + 1] = n;
   });
-  std::vector<TilePrim> bins;
-  for (auto& local : binLocals) bins.insert(bins.end(), local.begin(), local.end());
-  if (bins.size() * sizeof(TilePrim) > options.memoryLimitBytes)
-    fail<LimitError>("signed distance band: ", bins.size(), " primitive bins exceed the memory limit of ",
+  for (size_t k = 0; k < chunks; ++k) chunkStarts[k + 1] += chunkStarts[k];
+  if (chunkStarts[chunks] * sizeof(TilePrim) > options.memoryLimitBytes)
+    fail<LimitError>("signed distance band: ", chunkStarts[chunks], " primitive bins exceed the memory limit of ",
                      options.memoryLimitBytes >> 20, " MiB; use a narrower band or fewer cells");
+  std::vector<TilePrim> bins(chunkStarts[chunks]);
+  tbb::parallel_for(size_t(0), chunks, [&](size_t k) {
+    TilePrim* out = bins.data() + chunkStarts[k];
+    for (size_t p = k * chunk; p < std::min(prims, (k + 1) * chunk); ++p)
+      forTiles(p, [&](uint64_t tile) { *out++ = {tile, uint32_t(p)}; });
+  });
   tbb::parallel_sort(bins.begin(), bins.end());
   std::vector<size_t> starts;  // each tile's first bin
   for (size_t b = 0; b < bins.size(); ++b)

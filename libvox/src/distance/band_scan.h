@@ -65,7 +65,7 @@ struct Primitives {
   // The row constraints of triangle p, whose lower bound is `bound`, in its reach box c (not stored, for the same
   // reason). The bounds are not stored either: at 120 bytes a triangle they were the band's largest table (533 MB
   // at 4.4 M triangles), and a triangle's is recomputed in each of the few tiles its reach meets for about 1% of the
-  // band's time (docs/distance.md "Memory").
+  // band's time (docs/distance.md "Not met").
   RowScan rows(size_t p, const TriangleLowerBound& bound, const Reachable& c) const;
   size_t count() const { return scene.triangles.size() + shapes.size(); }
 };

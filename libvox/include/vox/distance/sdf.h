@@ -118,5 +118,10 @@ void checkNumericDomainOfPlan(const Scene& scene, const VoxelizeOptions& options
 // signedDistanceBand stored in `grid` (sdfHalfWidth, sdfKeys, sdfValues), what vox-voxelize --sdf and
 // libvox.voxelize(sdf=) do. `filled` is kept for callers: the signs no longer need the fill.
 void storeSignedDistances(Grid& grid, const Scene& scene, const SdfOptions& options, bool filled);
+// The same, bit for bit, without the copy of the scene in its power-of-two frame (80 bytes a triangle at the peak
+// of --sdf's memory): the scene's triangles are scaled into the frame in place and back, exactly as they were, before
+// it returns or throws. Copied as above when the way back could round (a coordinate near the smallest normal double
+// in a scene scaled down). Nothing else may use `scene` meanwhile. What vox-voxelize --sdf does.
+void storeSignedDistancesInPlace(Grid& grid, Scene& scene, const SdfOptions& options);
 
 }  // namespace vox

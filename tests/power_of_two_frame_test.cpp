@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -14,6 +15,7 @@
 #include "vox/core/error.h"
 #include "vox/distance/queries.h"
 #include "vox/distance/sdf.h"
+#include "vox/import/import.h"
 #include "vox/export/npz_writer.h"
 #include "vox/io/grid_file.h"
 #include "vox/volume/fractions.h"
@@ -265,6 +267,51 @@ TEST(PowerOfTwoFrame, CoordinatesBeyond2Pow1020AreRefused) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("is beyond +-1.1235582092889474e+307 (2^1020)"), std::string::npos)
         << e.what();
+  }
+}
+
+// vox-voxelize's route (storeSignedDistancesInPlace, which scales the scene's own triangles into the frame and back
+// instead of copying them) equals the copying one bit for bit, and gives the scene back as it was: scaled up, not
+// scaled, scaled down, and with a coordinate the way back would round (copied instead); also when it throws.
+TEST(PowerOfTwoFrame, InPlaceSignedDistancesEqualTheCopyAndGiveTheSceneBack) {
+  std::vector<std::pair<Scene, std::string>> scenes;
+  for (const int k : {-1000, -3, 0, 5, 1000}) scenes.push_back({cube(-0.5, k), "cube 2^" + std::to_string(k)});
+  scenes.push_back({cube(0.5, 0), "cube in its own frame"});
+  scenes.push_back({loadScene(testing::seed("meshes/bun_zipper.ply")), "bunny"});
+  Scene subnormal = cube(0, 1000);  // 2^-1074 scaled by 2^-1000 is no double: the way back would give 0
+  subnormal.triangles.push_back(
+      {{Vec3{0, 0, 0}, Vec3{std::ldexp(1.0, -1074), 0, 0}, Vec3{0, std::ldexp(1.0, 999), 0}}});
+  scenes.push_back({subnormal, "a subnormal coordinate at 2^1000"});
+  const auto coordinates = [](const Scene& s) {
+    std::vector<double> out;
+    for (const Triangle& t : s.triangles)
+      for (const Vec3& v : t.v) out.insert(out.end(), {v.x, v.y, v.z});
+    return out;
+  };
+  for (auto& [scene, what] : scenes) {
+    VoxelizeOptions vo;
+    vo.resolution = 24;
+    vo = withCubicCells(scene, vo);
+    const Grid plain = voxelizeScene(scene, vo);
+    SdfOptions so;
+    so.halfWidth = 3;
+    Grid copied = plain, inPlace = plain;
+    storeSignedDistances(copied, scene, so, false);
+    const std::vector<double> before = coordinates(scene);
+    storeSignedDistancesInPlace(inPlace, scene, so);
+    ASSERT_FALSE(copied.sdfKeys.empty()) << what;
+    ASSERT_EQ(inPlace.sdfKeys, copied.sdfKeys) << what;
+    for (size_t b = 0; b < copied.sdfValues.size(); ++b)  // bitwise: -0.0 is not +0.0
+      ASSERT_EQ(std::signbit(inPlace.sdfValues[b]), std::signbit(copied.sdfValues[b])) << what << " " << b;
+    ASSERT_EQ(inPlace.sdfValues, copied.sdfValues) << what;
+    for (int a = 0; a < 3; ++a) ASSERT_EQ(inPlace.bounds.lo[a], plain.bounds.lo[a]) << what;
+    const std::vector<double> after = coordinates(scene);
+    ASSERT_EQ(std::memcmp(after.data(), before.data(), before.size() * sizeof(double)), 0) << what;
+    Grid cancelled = plain;
+    so.progress = [](double) { return false; };
+    EXPECT_THROW(storeSignedDistancesInPlace(cancelled, scene, so), Error) << what;
+    const std::vector<double> afterThrow = coordinates(scene);
+    ASSERT_EQ(std::memcmp(afterThrow.data(), before.data(), before.size() * sizeof(double)), 0) << what;
   }
 }
 

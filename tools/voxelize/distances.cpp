@@ -23,7 +23,7 @@ VoxelizeOptions cubicCellsForDistances(const Options& opt, const Scene& scene, V
   return opt.sdf ? withCubicCells(scene, vo) : vo;
 }
 
-void addDistances(const Options& opt, const Scene& scene, uint64_t memoryLimitBytes, Grid& grid) {
+void addDistances(const Options& opt, Scene& scene, uint64_t memoryLimitBytes, Grid& grid) {
   if (opt.sdf) {
     if (!scene.planes.empty() && !opt.common.quiet)
       std::fputs(warningLine("vox-voxelize", opt.scene + ": " + std::to_string(scene.planes.size()) +
@@ -38,7 +38,7 @@ void addDistances(const Options& opt, const Scene& scene, uint64_t memoryLimitBy
       bar.update(f);
       return true;
     };
-    storeSignedDistances(grid, scene, so, opt.fill);
+    storeSignedDistancesInPlace(grid, scene, so);
     bar.finish();
   }
   if (opt.fraction) {

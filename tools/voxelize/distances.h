@@ -18,9 +18,9 @@ void checkDistanceFlags(const Options& opt);
 // `vo` unchanged otherwise.
 VoxelizeOptions cubicCellsForDistances(const Options& opt, const Scene& scene, VoxelizeOptions vo);
 
-// With --sdf: stores the band in `grid` (storeSignedDistances; the fill runs on the side without --fill), with a
-// progress bar and a warning for planes. With --fraction (which implies --fill): the occupied cells' volume
+// With --sdf: stores the band in `grid` (storeSignedDistancesInPlace: `scene` is lent and given back as it was),
+// with a progress bar and a warning for planes. With --fraction (which implies --fill): the occupied cells' volume
 // fractions (volumeFractions).
-void addDistances(const Options& opt, const Scene& scene, uint64_t memoryLimitBytes, Grid& grid);
+void addDistances(const Options& opt, Scene& scene, uint64_t memoryLimitBytes, Grid& grid);
 
 }  // namespace vox::voxelize_tool

@@ -25,8 +25,9 @@ double secondsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-// Voxelizes (and fills, with --fill) with progress bars; what the scene asks for is named with the scene.
-Grid voxelizeAndFill(const Options& opt, const Scene& scene, VoxelizeOptions vo, VoxelizeStats& stats) {
+// Voxelizes (and fills, with --fill) with progress bars; what the scene asks for is named with the scene. `scene` is
+// lent to the signed distances (addDistances) and given back as it was.
+Grid voxelizeAndFill(const Options& opt, Scene& scene, VoxelizeOptions vo, VoxelizeStats& stats) {
   ProgressBar bar("voxelizing", opt.common.quiet);
   vo.progress = [&](double f) {
     bar.update(f);
@@ -68,7 +69,7 @@ int run(const Options& opt) {
   voxelize_tool::checkDistanceFlags(opt);
   if (!opt.bricks.empty()) checkGridSetOutput(opt.output);  // "-o foo.bricks": refused before any work
   const std::optional<GridSetManifest> previousSet = opt.bricks.empty() ? previousGridSet(opt.output) : std::nullopt;
-  const Scene scene = loadScene(opt.scene);
+  Scene scene = loadScene(opt.scene);
   voxelize_tool::GridTimes times;
   times.read = secondsSince(start);
   if (!opt.common.quiet)

@@ -111,8 +111,6 @@ Primitives::Primitives(const Grid& grid, const Scene& scene, double reachDistanc
       reachDistance(reachDistance),
       reach2(reachDistance * reachDistance) {
   for (const Sphere& s : scene.spheres) shapes.push_back(ellipsoidShape(s));
-  bounds.resize(scene.triangles.size());
-  for (size_t t = 0; t < bounds.size(); ++t) bounds[t] = triangleLowerBound(scene.triangles[t]);
 }
 
 Reachable Primitives::reach(size_t p) const {
@@ -123,13 +121,13 @@ Reachable Primitives::reach(size_t p) const {
   return r;
 }
 
-RowScan Primitives::rows(size_t p, const Reachable& c) const {
+RowScan Primitives::rows(size_t p, const TriangleLowerBound& bound, const Reachable& c) const {
   Box centreBox;
   for (int a = 0; a < 3; ++a) {
     centreBox.lo.at(a) = centres[a][size_t(c.cells[a][0])];
     centreBox.hi.at(a) = centres[a][size_t(c.cells[a][1])];
   }
-  return rowScan(scene.triangles[p], bounds[p], centreBox, reachDistance);
+  return rowScan(scene.triangles[p], bound, centreBox, reachDistance);
 }
 
 Box Primitives::box(size_t p) const {
@@ -184,11 +182,12 @@ void TileEvaluator::boxes(const Primitives& primitives, const int64_t t0[3], con
   const size_t triangles = primitives.scene.triangles.size();
   for (size_t q = 0; q < count; ++q) {
     const size_t p = prims[q];
+    const TriangleLowerBound bound =
+        p < triangles ? triangleLowerBound(primitives.scene.triangles[p]) : TriangleLowerBound{};
     forCellsInReach(primitives, p, t0, nearest, [&](double& slot, const Vec3& c) {
-      const double d2 = p < triangles
-                            ? squaredDistanceToTriangleWithin(primitives.scene.triangles[p], primitives.bounds[p], c,
-                                                              std::min(slot, primitives.reach2))
-                            : squaredDistanceToShape(primitives, p - triangles, c);
+      const double d2 = p < triangles ? squaredDistanceToTriangleWithin(primitives.scene.triangles[p], bound, c,
+                                                                        std::min(slot, primitives.reach2))
+                                      : squaredDistanceToShape(primitives, p - triangles, c);
       if (d2 < slot) slot = d2;
     });
   }
@@ -211,9 +210,9 @@ void TileEvaluator::scan(const Primitives& primitives, const int64_t t0[3], cons
     const uint32_t p = prims[q];
     if (p >= triangles) continue;
     const Triangle& t = scene.triangles[p];
-    const TriangleLowerBound& bound = primitives.bounds[p];
+    const TriangleLowerBound bound = triangleLowerBound(t);
     const Reachable reach = primitives.reach(p);
-    const RowScan rows = primitives.rows(p, reach);
+    const RowScan rows = primitives.rows(p, bound, reach);
     const Vec3& a = t.v[0];
     int64_t lo[3], hi[3];
     tileRange(reach, t0, centres, lo, hi);

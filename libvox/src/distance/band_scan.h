@@ -58,13 +58,15 @@ struct Primitives {
   std::array<std::vector<double>, 3> centres;  // cell centres by axis
   double reachDistance, reach2;
   std::vector<EllipsoidShape> shapes;
-  std::vector<TriangleLowerBound> bounds;  // of the triangles
   Box box(size_t p) const;
   // The primitive's box grown by the reach, in cells (computed each time: a table would add 3 MB at 256^3, where the
   // band's peak memory is that of the whole process).
   Reachable reach(size_t p) const;
-  // The row constraints of triangle p in its reach box c (not stored, for the same reason).
-  RowScan rows(size_t p, const Reachable& c) const;
+  // The row constraints of triangle p, whose lower bound is `bound`, in its reach box c (not stored, for the same
+  // reason). The bounds are not stored either: at 120 bytes a triangle they were the band's largest table (533 MB
+  // at 4.4 M triangles), and a triangle's is recomputed in each of the few tiles its reach meets (about 3): 1.8% of
+  // the process's samples at 1.1 M triangles and 1024^3 (docs/distance.md "Not met").
+  RowScan rows(size_t p, const TriangleLowerBound& bound, const Reachable& c) const;
   size_t count() const { return scene.triangles.size() + shapes.size(); }
 };
 

@@ -44,7 +44,14 @@ constexpr uint32_t kLineLeaf = 4;
 
 }  // namespace
 
-InsideTest::InsideTest(const Scene& scene) {
+InsideTest::InsideTest(const Scene& scene) { build(scene); }
+
+InsideTest::InsideTest(const Scene& scene, const PowerOfTwoFrame& frame)
+    : framed_(std::make_shared<const Scene>(sceneInFrame(scene, frame))), frame_(frame) {
+  build(*framed_);
+}
+
+void InsideTest::build(const Scene& scene) {
   shapes_.reserve(scene.spheres.size());
   for (const Sphere& s : scene.spheres) shapes_.push_back(ellipsoidShape(s));
   if (scene.triangles.empty()) return;
@@ -55,21 +62,17 @@ InsideTest::InsideTest(const Scene& scene) {
     tree_ = buildWindingTree({scene.triangles.data(), scene.triangles.size()});
     return;
   }
-  triangles_.assign(scene.triangles.begin(), scene.triangles.end());
-  meshCount_ = triangles_.size();
-  for (const OpenBoundary& b : boundaries_) triangles_.insert(triangles_.end(), b.cap.begin(), b.cap.end());
-  capTree_ = buildWindingTree({triangles_.data() + meshCount_, triangles_.size() - meshCount_});
-  if (triangles_.size() > UINT32_MAX) fail<LimitError>("inside test: more than 2^32 - 1 triangles with the caps");
+  mesh_ = {scene.triangles.data(), scene.triangles.size()};
+  for (const OpenBoundary& b : boundaries_) caps_.insert(caps_.end(), b.cap.begin(), b.cap.end());
+  capTree_ = buildWindingTree({caps_.data(), caps_.size()});
+  const size_t count = mesh_.size() + caps_.size();
+  if (count > UINT32_MAX) fail<LimitError>("inside test: more than 2^32 - 1 triangles with the caps");
   // Triangles edge-on to x are never crossed: left out of the tree.
-  for (uint32_t t = 0; t < triangles_.size(); ++t) {
-    const Vec3 &a = triangles_[t].v[0], &b = triangles_[t].v[1], &c = triangles_[t].v[2];
+  for (uint32_t t = 0; t < count; ++t) {
+    const Vec3 &a = triangle(t).v[0], &b = triangle(t).v[1], &c = triangle(t).v[2];
     if (orient2d(a.y, a.z, b.y, b.z, c.y, c.z) != 0) order_.push_back(t);
   }
   if (!order_.empty()) buildLineTree(0, uint32_t(order_.size()));
-}
-
-InsideTest::InsideTest(const Scene& scene, const PowerOfTwoFrame& frame) : InsideTest(sceneInFrame(scene, frame)) {
-  frame_ = frame;
 }
 
 // Median split of order_[begin, end) on the longer axis of the (y, z) centroids; depth first, so the first child
@@ -81,7 +84,7 @@ uint32_t InsideTest::buildLineTree(uint32_t begin, uint32_t end) {
   double clo[2] = {INFINITY, INFINITY}, chi[2] = {-INFINITY, -INFINITY};
   for (uint32_t s = begin; s < end; ++s)
     for (const int a : {0, 1}) {
-      const Triangle& t = triangles_[order_[s]];
+      const Triangle& t = triangle(order_[s]);
       const double u = t.v[0][a + 1], v = t.v[1][a + 1], w = t.v[2][a + 1];
       n.lo[a] = std::min({n.lo[a], u, v, w});
       n.hi[a] = std::max({n.hi[a], u, v, w});
@@ -96,7 +99,7 @@ uint32_t InsideTest::buildLineTree(uint32_t begin, uint32_t end) {
   const int axis = chi[0] - clo[0] >= chi[1] - clo[1] ? 1 : 2;
   const uint32_t mid = begin + (end - begin) / 2;
   std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end, [&](uint32_t p, uint32_t q) {
-    const Triangle &a = triangles_[p], &b = triangles_[q];
+    const Triangle &a = triangle(p), &b = triangle(q);
     return a.v[0][axis] + a.v[1][axis] + a.v[2][axis] < b.v[0][axis] + b.v[1][axis] + b.v[2][axis];
   });
   buildLineTree(begin, mid);
@@ -121,7 +124,7 @@ void InsideTest::rowCrossings(double qy, double qz, std::vector<Crossing>& out) 
       continue;
     }
     for (uint32_t s = n.first; s < n.first + n.count; ++s) {
-      const Triangle& t = triangles_[order_[s]];
+      const Triangle& t = triangle(order_[s]);
       if (qy < std::min({t.v[0].y, t.v[1].y, t.v[2].y}) || qy > std::max({t.v[0].y, t.v[1].y, t.v[2].y}) ||
           qz < std::min({t.v[0].z, t.v[1].z, t.v[2].z}) || qz > std::max({t.v[0].z, t.v[1].z, t.v[2].z}))
         continue;  // the perturbed line cannot cross it either
@@ -146,22 +149,21 @@ bool InsideTest::inside(const Vec3& p, const std::vector<Crossing>& crossings) c
     if (p.x < x.xlo) continue;
     int side = x.sign;
     if (p.x <= x.xhi) {
-      const Triangle& t = triangles_[x.triangle];
+      const Triangle& t = triangle(x.triangle);
       side = orient3d(t.v[0], t.v[1], t.v[2], p);
       // On a mesh triangle p is on the surface (distance 0, unsigned); on a cap, k and s both jump there.
-      if (side == 0 && x.triangle >= meshCount_) onCap = true;
+      if (side == 0 && x.triangle >= mesh_.size()) onCap = true;
     }
     if (side == x.sign) k -= x.sign;
   }
-  const std::span<const Triangle> mesh(triangles_.data(), meshCount_);
-  if (onCap) return std::fabs(windingNumberExact(mesh, p)) >= kWindingThreshold;
+  if (onCap) return std::fabs(windingNumberExact(mesh_, p)) >= kWindingThreshold;
   if (capWindingBound(boundaries_, Box{p, p}) < kCapBoundForInteger) return k != 0;
   // The caps' tree first (beta 2: errors of about 1e-3, and 0.03 seen at worst on grazing views); the exact sum
   // over the caps' triangles only where |k - s| lies within kExactMargin of the threshold.
   constexpr double kExactMargin = 0.25;
   const double rough = std::fabs(double(k) - windingNumber(capTree_, p));
   if (std::fabs(rough - kWindingThreshold) > kExactMargin) return rough >= kWindingThreshold;
-  const double s = windingNumberExact({triangles_.data() + meshCount_, triangles_.size() - meshCount_}, p);
+  const double s = windingNumberExact({caps_.data(), caps_.size()}, p);
   return std::fabs(double(k) - s) >= kWindingThreshold;
 }
 

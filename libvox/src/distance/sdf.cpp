@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <span>
+#include <utility>
 
 #include "vox/core/error.h"
 #include "vox/core/exact_number.h"
@@ -55,24 +57,33 @@ std::vector<std::vector<Candidate>> bandCandidates(const Grid& grid, const Scene
   const size_t prims = primitives.count();
   std::array<uint64_t, 3> tiles;
   for (int a = 0; a < 3; ++a) tiles[a] = (grid.dims[a] + kTile - 1) / kTile;
-  // Bins.
-  tbb::enumerable_thread_specific<std::vector<TilePrim>> binLocals;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, prims, 1024), [&](const tbb::blocked_range<size_t>& r) {
-    std::vector<TilePrim>& out = binLocals.local();
-    for (size_t p = r.begin(); p < r.end(); ++p) {
-      const band::Reachable c = primitives.reach(p);
-      if (c.empty()) continue;
-      for (int64_t tz = c.cells[2][0] / kTile; tz <= c.cells[2][1] / kTile; ++tz)
-        for (int64_t ty = c.cells[1][0] / kTile; ty <= c.cells[1][1] / kTile; ++ty)
-          for (int64_t tx = c.cells[0][0] / kTile; tx <= c.cells[0][1] / kTile; ++tx)
-            out.push_back({uint64_t(tx) + tiles[0] * (uint64_t(ty) + tiles[1] * uint64_t(tz)), uint32_t(p)});
-    }
+  // Bins, counted first and then written in place: per-thread vectors grown by push_back and then concatenated
+  // held them twice over at the peak, with their growth's slack (docs/distance.md "Not met").
+  const size_t chunk = 4096, chunks = (prims + chunk - 1) / chunk;
+  const auto forTiles = [&](size_t p, const auto& visit) {
+    const band::Reachable c = primitives.reach(p);
+    if (c.empty()) return;
+    for (int64_t tz = c.cells[2][0] / kTile; tz <= c.cells[2][1] / kTile; ++tz)
+      for (int64_t ty = c.cells[1][0] / kTile; ty <= c.cells[1][1] / kTile; ++ty)
+        for (int64_t tx = c.cells[0][0] / kTile; tx <= c.cells[0][1] / kTile; ++tx)
+          visit(uint64_t(tx) + tiles[0] * (uint64_t(ty) + tiles[1] * uint64_t(tz)));
+  };
+  std::vector<size_t> chunkStarts(chunks + 1, 0);  // each chunk's first bin, after the prefix sum
+  tbb::parallel_for(size_t(0), chunks, [&](size_t k) {
+    size_t n = 0;
+    for (size_t p = k * chunk; p < std::min(prims, (k + 1) * chunk); ++p) forTiles(p, [&](uint64_t) { ++n; });
+    chunkStarts[k + 1] = n;
   });
-  std::vector<TilePrim> bins;
-  for (auto& local : binLocals) bins.insert(bins.end(), local.begin(), local.end());
-  if (bins.size() * sizeof(TilePrim) > options.memoryLimitBytes)
-    fail<LimitError>("signed distance band: ", bins.size(), " primitive bins exceed the memory limit of ",
+  for (size_t k = 0; k < chunks; ++k) chunkStarts[k + 1] += chunkStarts[k];
+  if (chunkStarts[chunks] * sizeof(TilePrim) > options.memoryLimitBytes)
+    fail<LimitError>("signed distance band: ", chunkStarts[chunks], " primitive bins exceed the memory limit of ",
                      options.memoryLimitBytes >> 20, " MiB; use a narrower band or fewer cells");
+  std::vector<TilePrim> bins(chunkStarts[chunks]);
+  tbb::parallel_for(size_t(0), chunks, [&](size_t k) {
+    TilePrim* out = bins.data() + chunkStarts[k];
+    for (size_t p = k * chunk; p < std::min(prims, (k + 1) * chunk); ++p)
+      forTiles(p, [&](uint64_t tile) { *out++ = {tile, uint32_t(p)}; });
+  });
   tbb::parallel_sort(bins.begin(), bins.end());
   std::vector<size_t> starts;  // each tile's first bin
   for (size_t b = 0; b < bins.size(); ++b)
@@ -208,6 +219,65 @@ namespace {
 
 void storeFramedSignedDistances(Grid& grid, const Scene& scene, const SdfOptions& options);
 
+// storeFramedSignedDistances over `framed`, the scene in `frame`, with the grid's bounds in the frame meanwhile; the
+// distances then scaled back to the world's units.
+void storeThroughFrame(Grid& grid, const Scene& framed, const PowerOfTwoFrame& frame, const SdfOptions& options) {
+  {
+    const FramedBounds framedBounds(grid, frame);
+    storeFramedSignedDistances(grid, framed, options);
+  }
+  for (double& v : grid.sdfValues) v = frame.toWorld(v);
+}
+
+// Whether every coordinate comes back from the frame as it was: scaling by 2^-e rounds only a result below the
+// smallest normal double, which a scene scaled up (e <= 0: its magnitude brought up to [1, 2)) never reaches.
+bool roundTripsExactly(std::span<const Triangle> triangles, const PowerOfTwoFrame& frame) {
+  if (frame.exponent <= 0) return true;
+  for (const Triangle& t : triangles)
+    for (const Vec3& v : t.v)
+      for (int a = 0; a < 3; ++a)
+        if (frame.toWorld(frame.toFrame(v[a])) != v[a]) return false;
+  return true;
+}
+
+void scaleTriangles(HugeVector<Triangle>& triangles, double (PowerOfTwoFrame::*to)(double) const,
+                    const PowerOfTwoFrame& frame) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, triangles.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t t = r.begin(); t < r.end(); ++t)
+      for (Vec3& v : triangles[t].v) v = {(frame.*to)(v.x), (frame.*to)(v.y), (frame.*to)(v.z)};
+  });
+}
+
+// The scene in a frame whose triangles are the owner's own, moved and scaled in place, and given back scaled back
+// when it ends (sceneInFrame for the rest: spheres and planes are few).
+class SceneLentToFrame {
+ public:
+  SceneLentToFrame(Scene& owner, const PowerOfTwoFrame& frame) : owner_(owner), frame_(frame) {
+    HugeVector<Triangle> triangles = std::move(owner.triangles);
+    owner.triangles.clear();  // moved from: empty, so that sceneInFrame copies none
+    try {
+      framed_ = sceneInFrame(owner, frame);
+    } catch (...) {
+      owner.triangles = std::move(triangles);
+      throw;
+    }
+    framed_.triangles = std::move(triangles);
+    scaleTriangles(framed_.triangles, &PowerOfTwoFrame::toFrame, frame_);
+  }
+  ~SceneLentToFrame() {
+    scaleTriangles(framed_.triangles, &PowerOfTwoFrame::toWorld, frame_);
+    owner_.triangles = std::move(framed_.triangles);
+  }
+  SceneLentToFrame(const SceneLentToFrame&) = delete;
+  SceneLentToFrame& operator=(const SceneLentToFrame&) = delete;
+  const Scene& scene() const { return framed_; }
+
+ private:
+  Scene& owner_;
+  PowerOfTwoFrame frame_;
+  Scene framed_;
+};
+
 }  // namespace
 
 // The band is computed in the scene's power-of-two frame (docs/limits.md "Numeric domain"): a scene's band at scale
@@ -217,11 +287,17 @@ void storeSignedDistances(Grid& grid, const Scene& scene, const SdfOptions& opti
   const PowerOfTwoFrame frame = sceneFrame(scene);
   checkNumericDomain(scene, grid.bounds, grid.dims, frame, true, "--sdf");
   if (frame.identity()) return storeFramedSignedDistances(grid, scene, options);
-  {
-    const FramedBounds framed(grid, frame);
-    storeFramedSignedDistances(grid, sceneInFrame(scene, frame), options);
-  }
-  for (double& v : grid.sdfValues) v = frame.toWorld(v);
+  storeThroughFrame(grid, sceneInFrame(scene, frame), frame, options);
+}
+
+void storeSignedDistancesInPlace(Grid& grid, Scene& scene, const SdfOptions& options) {
+  const PowerOfTwoFrame frame = sceneFrame(scene);
+  if (frame.identity() || !roundTripsExactly(scene.triangles, frame))
+    return storeSignedDistances(grid, std::as_const(scene), options, false);
+  checkSdfHalfWidth(options.halfWidth, "--sdf");
+  checkNumericDomain(scene, grid.bounds, grid.dims, frame, true, "--sdf");
+  const SceneLentToFrame lent(scene, frame);
+  storeThroughFrame(grid, lent.scene(), frame, options);
 }
 
 namespace {

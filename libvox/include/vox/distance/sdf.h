@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "vox/core/grid.h"
@@ -50,9 +51,12 @@ struct SdfBand {
 // than kMaxCapBoundaries holes (a soup) fall back to the winding tree (windingNumberToDecide, about 1e-3 off).
 class InsideTest {
  public:
+  // The test views the scene's triangles without copying them (a copy was 80 bytes a triangle at the peak of
+  // --sdf's memory): `scene` must outlive it.
   explicit InsideTest(const Scene& scene);
   // The same over the scene scaled into `frame` (vox/core/power_of_two_frame.h): `inside` then takes points in
-  // that frame, where winding numbers of a scene at 1e-300 or 1e300 neither underflow nor overflow.
+  // that frame, where winding numbers of a scene at 1e-300 or 1e300 neither underflow nor overflow. The test keeps
+  // the scaled triangles itself (shared by its copies): `scene` need not outlive it.
   InsideTest(const Scene& scene, const PowerOfTwoFrame& frame);
   bool inside(const Vec3& p) const;
   const PowerOfTwoFrame& frame() const { return frame_; }
@@ -74,9 +78,13 @@ class InsideTest {
     uint32_t first = 0;   // leaf: first slot in order_; inner: the second child (the first is the next node)
     uint32_t count = 0;   // triangles of a leaf; 0 for an inner node
   };
+  void build(const Scene& scene);
   uint32_t buildLineTree(uint32_t begin, uint32_t end);
-  std::vector<Triangle> triangles_;  // the mesh's, then the caps'
-  size_t meshCount_ = 0;
+  // Triangle t of the mesh's, then the caps'.
+  const Triangle& triangle(size_t t) const { return t < mesh_.size() ? mesh_[t] : caps_[t - mesh_.size()]; }
+  std::shared_ptr<const Scene> framed_;  // the frame constructor's scaled scene, which mesh_ then views
+  std::span<const Triangle> mesh_;
+  std::vector<Triangle> caps_;
   std::vector<OpenBoundary> boundaries_;
   bool counted_ = false;  // caps built (at most kMaxCapBoundaries holes): k - s; otherwise the tree
   std::vector<LineNode> lineNodes_;
@@ -110,5 +118,10 @@ void checkNumericDomainOfPlan(const Scene& scene, const VoxelizeOptions& options
 // signedDistanceBand stored in `grid` (sdfHalfWidth, sdfKeys, sdfValues), what vox-voxelize --sdf and
 // libvox.voxelize(sdf=) do. `filled` is kept for callers: the signs no longer need the fill.
 void storeSignedDistances(Grid& grid, const Scene& scene, const SdfOptions& options, bool filled);
+// The same, bit for bit, without the copy of the scene in its power-of-two frame (80 bytes a triangle at the peak
+// of --sdf's memory): the scene's triangles are scaled into the frame in place and back, exactly as they were, before
+// it returns or throws. Copied as above when the way back could round (a coordinate near the smallest normal double
+// in a scene scaled down). Nothing else may use `scene` meanwhile. What vox-voxelize --sdf does.
+void storeSignedDistancesInPlace(Grid& grid, Scene& scene, const SdfOptions& options);
 
 }  // namespace vox

@@ -278,24 +278,29 @@ class SceneLentToFrame {
   Scene framed_;
 };
 
+// The scene's power-of-two frame, after the checks of the half-width and of the numeric domain both routes make.
+PowerOfTwoFrame checkedSdfFrame(const Grid& grid, const Scene& scene, const SdfOptions& options) {
+  checkSdfHalfWidth(options.halfWidth, "--sdf");
+  const PowerOfTwoFrame frame = sceneFrame(scene);
+  checkNumericDomain(scene, grid.bounds, grid.dims, frame, true, "--sdf");
+  return frame;
+}
+
 }  // namespace
 
 // The band is computed in the scene's power-of-two frame (docs/limits.md "Numeric domain"): a scene's band at scale
 // 2^k is its band at scale 1 times 2^k, bit for bit, and no squared distance overflows or underflows.
 void storeSignedDistances(Grid& grid, const Scene& scene, const SdfOptions& options, bool /*filled*/) {
-  checkSdfHalfWidth(options.halfWidth, "--sdf");
-  const PowerOfTwoFrame frame = sceneFrame(scene);
-  checkNumericDomain(scene, grid.bounds, grid.dims, frame, true, "--sdf");
+  const PowerOfTwoFrame frame = checkedSdfFrame(grid, scene, options);
   if (frame.identity()) return storeFramedSignedDistances(grid, scene, options);
   storeThroughFrame(grid, sceneInFrame(scene, frame), frame, options);
 }
 
 void storeSignedDistancesInPlace(Grid& grid, Scene& scene, const SdfOptions& options) {
-  const PowerOfTwoFrame frame = sceneFrame(scene);
-  if (frame.identity() || !roundTripsExactly(scene.triangles, frame))
-    return storeSignedDistances(grid, std::as_const(scene), options, false);
-  checkSdfHalfWidth(options.halfWidth, "--sdf");
-  checkNumericDomain(scene, grid.bounds, grid.dims, frame, true, "--sdf");
+  const PowerOfTwoFrame frame = checkedSdfFrame(grid, scene, options);
+  if (frame.identity()) return storeFramedSignedDistances(grid, scene, options);
+  if (!roundTripsExactly(scene.triangles, frame))
+    return storeThroughFrame(grid, sceneInFrame(scene, frame), frame, options);
   const SceneLentToFrame lent(scene, frame);
   storeThroughFrame(grid, lent.scene(), frame, options);
 }

@@ -284,26 +284,21 @@ double NearestPrimitive::squaredDistanceTo(uint32_t slot, const Vec3& p, double 
 }
 
 // The seed's exact distance is the first bound, tight when the seed is the answer or nearly so, so that the search
-// from the root opens few nodes. Ties still go to the lowest id: the seed's equals are visited and win by id.
-NearestHit NearestPrimitive::seeded(const Vec3& p, int64_t seed) const {
-  NearestHit best;
-  best.squaredDistance = squaredDistanceTo(slotOf_[size_t(seed)], p, INFINITY);
-  best.primitive = seed;
+// opens few nodes. Ties still go to the lowest id: the seed's equals are visited and win by id.
+NearestHit NearestPrimitive::searchFrom(const Vec3& p, int64_t seed, const WideNode* first, size_t firstCount) const {
+  if (seed < 0 || uint64_t(seed) >= ids_.size()) return nearest(p);
+  const uint32_t slot = slotOf_[size_t(seed)];
+  NearestHit best{squaredDistanceTo(slot, p, INFINITY), seed};
+  search(p, first, firstCount, best, slot);
   return best;
 }
 
 NearestHit NearestPrimitive::nearestFrom(const Vec3& p, int64_t seed) const {
-  if (seed < 0 || uint64_t(seed) >= ids_.size()) return nearest(p);
-  NearestHit best = seeded(p, seed);
-  search(p, wide_.data(), 1, best, slotOf_[size_t(seed)]);
-  return best;
+  return searchFrom(p, seed, wide_.data(), 1);
 }
 
 NearestHit NearestPrimitive::nearestFrom(const Vec3& p, int64_t seed, const Frontier& frontier) const {
-  if (seed < 0 || uint64_t(seed) >= ids_.size()) return nearest(p);
-  NearestHit best = seeded(p, seed);
-  search(p, frontier.nodes_.data(), frontier.nodes_.size(), best, slotOf_[size_t(seed)]);
-  return best;
+  return searchFrom(p, seed, frontier.nodes_.data(), frontier.nodes_.size());
 }
 
 NearestHit NearestPrimitive::nearest(const Vec3& p, double bound2) const {
@@ -470,7 +465,6 @@ void NearestPrimitive::gather(const Vec3& centre, double radius, double upper, s
     float size;  // the sum of its half extents
   };
   std::array<Entry, kMaxFrontier + 4> entries;
-  size_t count = 0;
   const auto keptChildren = [&](const WideNode& node, std::array<Entry, 4>& out) {
     const unsigned lanes =
         unsigned(_mm_movemask_ps(_mm_cmple_ps(childBounds(node, qx, qy, qz, qn), keep2))) & ((1u << node.count) - 1);
@@ -482,7 +476,7 @@ void NearestPrimitive::gather(const Vec3& centre, double radius, double upper, s
     return n;
   };
   std::array<Entry, 4> children;
-  count = keptChildren(wide_[0], children);
+  size_t count = keptChildren(wide_[0], children);
   std::copy_n(children.begin(), count, entries.begin());
   maxEntries = std::clamp<size_t>(maxEntries, 4, kMaxFrontier);
   // The largest inner child replaced by its kept children while they fit.

@@ -96,7 +96,8 @@ class NearestPrimitive {
   // the slot of a primitive whose distance `best` already took into account (a seed), not computed again.
   static constexpr uint32_t kNoSlot = UINT32_MAX;
   void search(const Vec3& p, const WideNode* nodes, size_t count, NearestHit& best, uint32_t known = kNoSlot) const;
-  NearestHit seeded(const Vec3& p, int64_t seed) const;
+  // nearestFrom over the children of first[0, firstCount).
+  NearestHit searchFrom(const Vec3& p, int64_t seed, const WideNode* first, size_t firstCount) const;
   void visitLeaf(const WideLeaf& leaf, const Vec3& p, const float (&q)[3], float qNorm, bool prune, float bestUp,
                  uint32_t known, NearestHit& best) const;
   uint32_t build(uint32_t begin, uint32_t end, const std::vector<Vec3>& centroids, std::vector<BinaryNode>& nodes);
